@@ -1,0 +1,130 @@
+#ifndef hysteron_base_output_h
+#define hysteron_base_output_h
+
+#include <deal.II/base/data_out_base.h>
+#include <deal.II/base/mpi.h>
+
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace hysteron
+{
+  namespace Output
+  {
+    /**
+     * Create @p directory (with parents) and check that we can write into it.
+     * Throws InputError at @p where ("Output/Directory") otherwise.
+     */
+    void
+    prepare_directory(const std::string &directory, const std::string &where);
+
+    /**
+     * A file that appears under its final name only when complete: the content
+     * goes to "<name>.tmp", commit() closes and renames it. A file that is never
+     * committed (an exception, a failed run) is removed, so a reader never sees
+     * a half-written output.
+     */
+    class AtomicFile
+    {
+    public:
+      explicit AtomicFile(const std::string &filename);
+      ~AtomicFile();
+
+      AtomicFile(const AtomicFile &) = delete;
+      AtomicFile &
+      operator=(const AtomicFile &) = delete;
+
+      std::ofstream &
+      stream()
+      {
+        return out;
+      }
+
+      /// Flush, close and rename to the final name. Throws RuntimeError on an I/O error.
+      void
+      commit();
+
+      const std::string &
+      filename() const
+      {
+        return final_name;
+      }
+
+    private:
+      std::string   final_name;
+      std::string   temporary_name;
+      std::ofstream out;
+      bool          committed = false;
+    };
+
+    /// Write @p content to @p filename atomically.
+    void
+    write_file(const std::string &filename, const std::string &content);
+
+    /**
+     * A CSV table with a header line. Rows are written with 12 significant
+     * digits. The table is an AtomicFile: it appears under its name on commit().
+     */
+    class CsvWriter
+    {
+    public:
+      CsvWriter(const std::string &filename, const std::vector<std::string> &columns);
+
+      std::size_t
+      n_columns() const
+      {
+        return columns.size();
+      }
+
+      /// Append one row; its length must equal the number of columns.
+      void
+      add_row(const std::vector<double> &values);
+
+      void
+      commit()
+      {
+        file.commit();
+      }
+
+    private:
+      std::vector<std::string> columns;
+      AtomicFile               file;
+    };
+
+    /**
+     * Field output for ParaView: every call to write() produces
+     * "<base>-<step>.vtu" (on one rank) or "<base>-<step>.<rank>.vtu" plus a
+     * ".pvtu" record (on several), and rewrites "<base>.pvd" with the list of
+     * (time, file). All files are written atomically. Works for any
+     * DataOutInterface: DataOut (FEM, background grid), Particles::DataOut (MPM),
+     * or the custom patches of the RBSN cells.
+     */
+    class FieldWriter
+    {
+    public:
+      FieldWriter(const std::string &directory, const std::string &base_name, MPI_Comm comm);
+
+      template <int dim, int spacedim>
+      void
+      write(const dealii::DataOutInterface<dim, spacedim> &data_out, double time);
+
+      /// The (time, file) list written so far.
+      const std::vector<std::pair<double, std::string>> &
+      records() const
+      {
+        return times_and_names;
+      }
+
+    private:
+      std::string                                 directory;
+      std::string                                 base_name;
+      MPI_Comm                                    comm;
+      unsigned int                                counter = 0;
+      std::vector<std::pair<double, std::string>> times_and_names;
+    };
+  } // namespace Output
+} // namespace hysteron
+
+#endif

@@ -1,0 +1,148 @@
+#ifndef hysteron_material_interface_h
+#define hysteron_material_interface_h
+
+#include <deal.II/base/array_view.h>
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/symmetric_tensor.h>
+
+#include <hysteron/base/parameters.h>
+#include <hysteron/base/registry.h>
+#include <hysteron/material/elasticity.h>
+
+#include <string>
+#include <vector>
+
+namespace hysteron
+{
+  namespace Material
+  {
+    /**
+     * The interface of every constitutive model (deal.II style: a class
+     * templated on dim; SymmetricTensor at the interface).
+     *
+     * A model is a map (strain increment, stress, state) -> (stress, state,
+     * tangent). The per-point state is a flat, fixed-size array of doubles
+     * (n_state_variables() of them, each with a name), so that it packs into
+     * particle properties, quadrature-point history and spring arrays alike.
+     *
+     * update() works on a batch of points: one virtual call per batch, and the
+     * model's own loop inside, so that hot loops (MPM particles, FEM quadrature
+     * points) pay no virtual call per point.
+     *
+     * Writing a new model: derive from this class, implement update() (and the
+     * state description if the model has internal variables), give it a static
+     * declare_parameters(ParameterHandler &) that declares its entries inside
+     * `subsection Material`, override parse_parameters(), and register it with
+     * HYSTERON_REGISTER_MATERIAL(ClassName, "name", "description").
+     */
+    template <int dim>
+    class Interface
+    {
+    public:
+      virtual ~Interface() = default;
+
+      /// The entries every model shares are declared by the scene; a model adds its own.
+      static void
+      declare_parameters(dealii::ParameterHandler &)
+      {}
+
+      /**
+       * Store the elastic constants (read by the scene) and let the model read
+       * its own parameters from @p section (the `Material` subsection).
+       */
+      void
+      initialize(const Elasticity &elasticity, const Section &section);
+
+      const Elasticity &
+      elasticity() const
+      {
+        return elastic;
+      }
+
+      double
+      density() const
+      {
+        return elastic.density;
+      }
+
+      /// Number of doubles of per-point state.
+      virtual unsigned int
+      n_state_variables() const
+      {
+        return 0;
+      }
+
+      /// One name per state slot (CSV columns, particle output).
+      virtual std::vector<std::string>
+      state_variable_names() const
+      {
+        return {};
+      }
+
+      /// The state of a virgin point (default: zeros).
+      virtual void
+      initialize_state(const dealii::ArrayView<double> &state) const;
+
+      /**
+       * Advance n points by their strain increments.
+       * @param strain_increments n tensors (tensor shear components).
+       * @param stresses n tensors: in, the stress at the start; out, at the end.
+       * @param states n * n_state_variables() doubles, point after point.
+       * @param tangents empty, or n tensors receiving d(stress)/d(strain) of the
+       *        update (the algorithmic tangent where the model has one).
+       */
+      virtual void
+      update(const dealii::ArrayView<const dealii::SymmetricTensor<2, dim>> &strain_increments,
+             const dealii::ArrayView<dealii::SymmetricTensor<2, dim>>       &stresses,
+             const dealii::ArrayView<double>                                &states,
+             const dealii::ArrayView<dealii::SymmetricTensor<4, dim>>       &tangents) const = 0;
+
+      /// update() for one point.
+      void
+      update_point(const dealii::SymmetricTensor<2, dim> &strain_increment,
+                   dealii::SymmetricTensor<2, dim>       &stress,
+                   const dealii::ArrayView<double>       &state,
+                   dealii::SymmetricTensor<4, dim>       *tangent = nullptr) const;
+
+      /**
+       * In 2D: the out-of-plane strain eps_zz (plane stress) or stress sigma_zz
+       * (plane strain) of a point with in-plane @p strain, @p stress and @p state;
+       * the other one is zero. The default is the elastic relation
+       * eps_zz = -nu/E (s_xx + s_yy), resp. sigma_zz = nu (s_xx + s_yy);
+       * inelastic models override it.
+       */
+      virtual void
+      out_of_plane(const dealii::SymmetricTensor<2, dim> &strain,
+                   const dealii::SymmetricTensor<2, dim> &stress,
+                   const dealii::ArrayView<const double> &state,
+                   double                                &eps_zz,
+                   double                                &sigma_zz) const;
+
+    protected:
+      /// Read the model's own parameters (inside `subsection Material`).
+      virtual void
+      parse_parameters(const Section &section);
+
+    private:
+      Elasticity elastic;
+    };
+
+    template <int dim>
+    using Registry = Plugins::Registry<Interface<dim>>;
+
+    /// Declare `Model`, the elastic constants and every model's entries (inside `Material`).
+    void
+    declare_parameters(dealii::ParameterHandler &prm);
+
+    /// Read the entries declared by declare_parameters() and create the model.
+    template <int dim>
+    std::unique_ptr<Interface<dim>>
+    create(const Section &section);
+  } // namespace Material
+} // namespace hysteron
+
+/// Register a material model class template (dim = 2, 3) under @p name.
+#define HYSTERON_REGISTER_MATERIAL(classname, name, description) \
+  HYSTERON_REGISTER_DIM_PLUGIN(::hysteron::Material::Interface, classname, name, description)
+
+#endif

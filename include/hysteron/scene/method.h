@@ -1,0 +1,76 @@
+#ifndef hysteron_scene_method_h
+#define hysteron_scene_method_h
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <hysteron/base/registry.h>
+
+#include <string>
+
+namespace hysteron
+{
+  template <int dim>
+  class Scene;
+
+  namespace Methods
+  {
+    /**
+     * A discretisation that runs a scene: `material point`, `mpm`, `fem`,
+     * `rbsn`. A method declares its parameters in its own subsection (static
+     * declare_parameters), reads only those plus what the Scene offers (materials,
+     * time and output control, bodies), and never parses another method's
+     * parameters. Register with HYSTERON_REGISTER_METHOD.
+     */
+    template <int dim>
+    class Interface
+    {
+    public:
+      virtual ~Interface() = default;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &)
+      {}
+
+      /// Attach the scene and read the method's parameters (all checks happen here).
+      void
+      initialize(const Scene<dim> &scene, dealii::ParameterHandler &prm)
+      {
+        scene_ptr = &scene;
+        parse_parameters(prm);
+      }
+
+      /// Run the scene to the end, writing outputs into the scene's directory.
+      virtual void
+      run() = 0;
+
+      /// One line for the run summary ("4000 steps, 3 outputs").
+      virtual std::string
+      summary() const
+      {
+        return "";
+      }
+
+    protected:
+      virtual void
+      parse_parameters(dealii::ParameterHandler &prm) = 0;
+
+      const Scene<dim> &
+      get_scene() const
+      {
+        return *scene_ptr;
+      }
+
+    private:
+      const Scene<dim> *scene_ptr = nullptr;
+    };
+
+    template <int dim>
+    using Registry = Plugins::Registry<Interface<dim>>;
+  } // namespace Methods
+} // namespace hysteron
+
+/// Register a method class template (dim = 2, 3) under @p name.
+#define HYSTERON_REGISTER_METHOD(classname, name, description) \
+  HYSTERON_REGISTER_DIM_PLUGIN(::hysteron::Methods::Interface, classname, name, description)
+
+#endif

@@ -1,0 +1,163 @@
+#ifndef hysteron_scene_scene_h
+#define hysteron_scene_scene_h
+
+#include <deal.II/base/conditional_ostream.h>
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
+#include <deal.II/base/timer.h>
+
+#include <hysteron/material/interface.h>
+#include <hysteron/scene/method.h>
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace hysteron
+{
+  /// `subsection Time`: for the time-stepping methods (the material point has its own path).
+  struct TimeControl
+  {
+    double end_time   = 1.0;
+    double time_step  = 0.0; ///< 0: automatic from the CFL factor.
+    double cfl_factor = 0.5;
+
+    bool
+    automatic_time_step() const
+    {
+      return time_step == 0.0;
+    }
+  };
+
+  /// `subsection Output`.
+  template <int dim>
+  struct OutputControl
+  {
+    std::string              directory = "output";
+    double                   interval  = 0.0; ///< simulated seconds between field outputs
+    bool                     write_vtu = true;
+    std::vector<dealii::Point<dim>> probe_points;
+    double                   progress_interval = 2.0; ///< wall seconds between progress lines
+  };
+
+  /// How the executable was called.
+  struct RunOptions
+  {
+    std::string parameter_file;
+    bool        quiet = false;
+    MPI_Comm    comm  = MPI_COMM_WORLD;
+  };
+
+  /**
+   * What a .prm file describes, validated and in SI units: materials by name,
+   * time and output control, the random seed and the chosen method. Bodies,
+   * loads and boundary conditions are added here by the modules that need them
+   * (MPM, FEM, RBSN), as named subsections like the materials
+   * (see doc/architecture.md).
+   *
+   * run() prepares the output directory, writes the effective parameters to
+   * `parameters.prm`, runs the method and prints the summary and timer table.
+   */
+  template <int dim>
+  class Scene
+  {
+  public:
+    /// Every entry of every module (all methods, all material models).
+    static void
+    declare_parameters(dealii::ParameterHandler       &prm,
+                       const std::vector<std::string> &material_names);
+
+    /// Parse and validate everything, including the method's own parameters.
+    Scene(dealii::ParameterHandler &prm, const RunOptions &options);
+
+    void
+    run();
+
+    /// The material called @p name; "" is the default `subsection Material`.
+    const Material::Interface<dim> &
+    material(const std::string &name, const std::string &where) const;
+
+    std::vector<std::string>
+    material_names() const;
+
+    const TimeControl &
+    time_control() const
+    {
+      return time;
+    }
+
+    const OutputControl<dim> &
+    output_control() const
+    {
+      return output;
+    }
+
+    /// "<Output/Directory>/<file>".
+    std::string
+    output_file(const std::string &file) const
+    {
+      return output.directory + "/" + file;
+    }
+
+    unsigned int
+    random_seed() const
+    {
+      return seed;
+    }
+
+    MPI_Comm
+    mpi_communicator() const
+    {
+      return options.comm;
+    }
+
+    bool
+    is_root() const
+    {
+      return dealii::Utilities::MPI::this_mpi_process(options.comm) == 0;
+    }
+
+    bool
+    quiet() const
+    {
+      return options.quiet;
+    }
+
+    /// Progress and messages: rank 0 only, silent with --quiet.
+    dealii::ConditionalOStream &
+    console() const
+    {
+      return pcout;
+    }
+
+    dealii::TimerOutput &
+    timer() const
+    {
+      return computing_timer;
+    }
+
+  private:
+    RunOptions                                                      options;
+    mutable dealii::ConditionalOStream                              pcout;
+    mutable dealii::TimerOutput                                     computing_timer;
+    std::string                                                     method_name;
+    std::map<std::string, std::unique_ptr<Material::Interface<dim>>> materials;
+    TimeControl                                                     time;
+    OutputControl<dim>                                              output;
+    unsigned int                                                    seed = 0;
+    std::string                                                     effective_parameters;
+    std::unique_ptr<Methods::Interface<dim>>                        method;
+  };
+
+  /// Entries read before the full parse: Dimension, Method, Material names, libraries.
+  void
+  declare_preamble(dealii::ParameterHandler &prm);
+
+  /// The subsection name of a named material ("Material" for the default "").
+  std::string
+  material_subsection(const std::string &name);
+} // namespace hysteron
+
+#endif

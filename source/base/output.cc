@@ -1,0 +1,170 @@
+#include <deal.II/base/utilities.h>
+
+#include <hysteron/base/exceptions.h>
+#include <hysteron/base/output.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iomanip>
+#include <sstream>
+#include <unistd.h>
+
+namespace hysteron
+{
+  namespace Output
+  {
+    void
+    prepare_directory(const std::string &directory, const std::string &where)
+    {
+      namespace fs = std::filesystem;
+      require(!directory.empty(), where, "the output directory name is empty");
+      std::error_code ec;
+      fs::create_directories(directory, ec);
+      if (ec)
+        throw InputError(where, "cannot create the directory '" + directory + "': " + ec.message());
+      require(fs::is_directory(directory, ec),
+              where,
+              "'" + directory + "' exists and is not a directory");
+      require(::access(directory.c_str(), W_OK | X_OK) == 0,
+              where,
+              "the directory '" + directory + "' is not writable: " + std::strerror(errno));
+    }
+
+    AtomicFile::AtomicFile(const std::string &filename)
+      : final_name(filename)
+      , temporary_name(filename + ".tmp")
+      , out(temporary_name)
+    {
+      if (!out)
+        throw RuntimeError("cannot open '" + temporary_name + "' for writing: " +
+                           std::strerror(errno));
+    }
+
+    AtomicFile::~AtomicFile()
+    {
+      if (!committed)
+        {
+          out.close();
+          std::remove(temporary_name.c_str());
+        }
+    }
+
+    void
+    AtomicFile::commit()
+    {
+      if (committed)
+        return;
+      out.flush();
+      const bool good = static_cast<bool>(out);
+      out.close();
+      if (!good || std::rename(temporary_name.c_str(), final_name.c_str()) != 0)
+        {
+          std::remove(temporary_name.c_str());
+          throw RuntimeError("cannot write '" + final_name + "': " + std::strerror(errno));
+        }
+      committed = true;
+    }
+
+    void
+    write_file(const std::string &filename, const std::string &content)
+    {
+      AtomicFile file(filename);
+      file.stream() << content;
+      file.commit();
+    }
+
+    CsvWriter::CsvWriter(const std::string &filename, const std::vector<std::string> &columns)
+      : columns(columns)
+      , file(filename)
+    {
+      for (std::size_t i = 0; i < columns.size(); ++i)
+        file.stream() << (i == 0 ? "" : ",") << columns[i];
+      file.stream() << '\n' << std::setprecision(12);
+    }
+
+    void
+    CsvWriter::add_row(const std::vector<double> &values)
+    {
+      if (values.size() != columns.size())
+        throw std::logic_error("CsvWriter: a row of " + std::to_string(values.size()) +
+                               " values for " + std::to_string(columns.size()) + " columns");
+      auto &out = file.stream();
+      for (std::size_t i = 0; i < values.size(); ++i)
+        {
+          if (i > 0)
+            out << ',';
+          out << values[i] + 0.0; // + 0.0 prints -0 as 0
+        }
+      out << '\n';
+    }
+
+    FieldWriter::FieldWriter(const std::string &directory,
+                             const std::string &base_name,
+                             MPI_Comm           comm)
+      : directory(directory)
+      , base_name(base_name)
+      , comm(comm)
+    {}
+
+    template <int dim, int spacedim>
+    void
+    FieldWriter::write(const dealii::DataOutInterface<dim, spacedim> &data_out, const double time)
+    {
+      const unsigned int n_ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
+      const unsigned int rank    = dealii::Utilities::MPI::this_mpi_process(comm);
+      const std::string  stem = base_name + "-" + dealii::Utilities::int_to_string(counter, 5);
+
+      std::string record;
+      if (n_ranks == 1)
+        {
+          record = stem + ".vtu";
+          AtomicFile file(directory + "/" + record);
+          data_out.write_vtu(file.stream());
+          file.commit();
+        }
+      else
+        {
+          const std::string piece = stem + "." + dealii::Utilities::int_to_string(rank, 4) + ".vtu";
+          {
+            AtomicFile file(directory + "/" + piece);
+            data_out.write_vtu(file.stream());
+            file.commit();
+          }
+          std::vector<std::string> pieces;
+          for (unsigned int r = 0; r < n_ranks; ++r)
+            pieces.push_back(stem + "." + dealii::Utilities::int_to_string(r, 4) + ".vtu");
+          record = stem + ".pvtu";
+          // Every piece must exist before the record that names it.
+          MPI_Barrier(comm);
+          if (rank == 0)
+            {
+              AtomicFile file(directory + "/" + record);
+              data_out.write_pvtu_record(file.stream(), pieces);
+              file.commit();
+            }
+        }
+
+      times_and_names.emplace_back(time, record);
+      if (rank == 0)
+        {
+          AtomicFile file(directory + "/" + base_name + ".pvd");
+          dealii::DataOutBase::write_pvd_record(file.stream(), times_and_names);
+          file.commit();
+        }
+      ++counter;
+    }
+
+    template void
+    FieldWriter::write<1, 2>(const dealii::DataOutInterface<1, 2> &, double);
+    template void
+    FieldWriter::write<2, 2>(const dealii::DataOutInterface<2, 2> &, double);
+    template void
+    FieldWriter::write<3, 3>(const dealii::DataOutInterface<3, 3> &, double);
+    template void
+    FieldWriter::write<0, 2>(const dealii::DataOutInterface<0, 2> &, double);
+    template void
+    FieldWriter::write<0, 3>(const dealii::DataOutInterface<0, 3> &, double);
+  } // namespace Output
+} // namespace hysteron

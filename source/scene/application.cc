@@ -1,0 +1,232 @@
+#include <deal.II/base/exceptions.h>
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/utilities.h>
+
+#include <hysteron/base/config.h>
+#include <hysteron/base/exceptions.h>
+#include <hysteron/base/parameters.h>
+#include <hysteron/scene/application.h>
+#include <hysteron/scene/scene.h>
+
+#include <dlfcn.h>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace hysteron
+{
+  namespace
+  {
+    const char *usage_text =
+      "Usage: hysteron [--quiet] SCENE.prm\n"
+      "       hysteron --print-parameters [prm|json] [SCENE.prm]\n"
+      "       hysteron --help | --version\n"
+      "\n"
+      "Runs the scene described by the parameter file SCENE.prm: its `Dimension` (2 or 3) and\n"
+      "`Method` (material point, ...) choose what runs; results go to `Output/Directory`.\n"
+      "\n"
+      "Options:\n"
+      "  --quiet              no progress, summary or timer table on stdout\n"
+      "  --print-parameters   write every parameter with its default, allowed values and\n"
+      "                       documentation (PRM format, or JSON) and exit; with SCENE.prm,\n"
+      "                       the values of that file and its named materials\n"
+      "  --help               this text\n"
+      "  --version            the version\n"
+      "\n"
+      "Exit status: 0 success, 1 bad input, 2 run-time failure, 3 internal error.\n"
+      "Documentation: README.md, doc/parameters.md, doc/architecture.md.\n";
+
+    /// A deal.II exception's own message, on one line, without the source location banner.
+    std::string
+    one_line(const dealii::ExceptionBase &e)
+    {
+      std::ostringstream info;
+      e.print_info(info);
+      std::string text = info.str();
+      std::string out;
+      bool        space = false;
+      for (const char c : text)
+        if (c == '\n' || c == ' ' || c == '\t')
+          space = !out.empty();
+        else
+          {
+            if (space)
+              out += ' ';
+            out += c;
+            space = false;
+          }
+      return out;
+    }
+
+    struct Preamble
+    {
+      unsigned int             dimension = 2;
+      std::vector<std::string> material_names;
+    };
+
+    /// Read Dimension, Material names and libraries, skipping everything else.
+    Preamble
+    read_preamble(const std::string &file)
+    {
+      dealii::ParameterHandler prm;
+      declare_preamble(prm);
+      prm.parse_input(file, "", /*skip_undefined=*/true);
+
+      Preamble p;
+      p.dimension      = prm.get_integer("Dimension");
+      p.material_names = parse_names(prm.get("Material names"), "Material names");
+      for (const auto &library : dealii::Utilities::split_string_list(
+             prm.get("Additional shared libraries"), ','))
+        if (!library.empty())
+          {
+            // RTLD_GLOBAL: the plugin's registration objects run now and register into
+            // the registries of this executable's library.
+            if (dlopen(library.c_str(), RTLD_NOW | RTLD_GLOBAL) == nullptr)
+              throw InputError("Additional shared libraries",
+                               "cannot load '" + library + "': " + dlerror());
+          }
+      return p;
+    }
+
+    void
+    check_readable(const std::string &file)
+    {
+      std::ifstream in(file);
+      require(static_cast<bool>(in), file, "cannot open the parameter file for reading");
+    }
+
+    template <int dim>
+    void
+    run_scene(dealii::ParameterHandler &prm, const RunOptions &options)
+    {
+      Scene<dim> scene(prm, options);
+      scene.run();
+    }
+
+    int
+    run(int argc, char **argv)
+    {
+      RunOptions  options;
+      bool        print_parameters = false;
+      std::string format           = "prm";
+      std::vector<std::string> files;
+      for (int i = 1; i < argc; ++i)
+        {
+          const std::string arg = argv[i];
+          if (arg == "--help" || arg == "-h")
+            {
+              if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+                std::cout << usage_text;
+              return 0;
+            }
+          else if (arg == "--version")
+            {
+              if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+                std::cout << "hysteron " HYSTERON_VERSION " (deal.II " DEAL_II_PACKAGE_VERSION ")\n";
+              return 0;
+            }
+          else if (arg == "--quiet" || arg == "-q")
+            options.quiet = true;
+          else if (arg == "--print-parameters")
+            {
+              print_parameters = true;
+              if (i + 1 < argc && (std::string(argv[i + 1]) == "prm" ||
+                                   std::string(argv[i + 1]) == "json"))
+                format = argv[++i];
+            }
+          else if (!arg.empty() && arg[0] == '-')
+            throw InputError("command line", "unknown option '" + arg + "' (see hysteron --help)");
+          else
+            files.push_back(arg);
+        }
+      if (files.size() > 1)
+        throw InputError("command line", "more than one parameter file given (see hysteron --help)");
+
+      Preamble preamble;
+      if (!files.empty())
+        {
+          options.parameter_file = files[0];
+          check_readable(files[0]);
+          try
+            {
+              preamble = read_preamble(files[0]);
+            }
+          catch (const dealii::ExceptionBase &e)
+            {
+              throw InputError(files[0], one_line(e));
+            }
+        }
+      else if (!print_parameters)
+        throw InputError("command line", "no parameter file given\n" + std::string(usage_text));
+
+      dealii::ParameterHandler prm;
+      if (preamble.dimension == 2)
+        Scene<2>::declare_parameters(prm, preamble.material_names);
+      else
+        Scene<3>::declare_parameters(prm, preamble.material_names);
+
+      if (!files.empty())
+        try
+          {
+            prm.parse_input(files[0]);
+          }
+        catch (const dealii::ExceptionBase &e)
+          {
+            throw InputError(files[0], one_line(e));
+          }
+
+      if (print_parameters)
+        {
+          if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+            prm.print_parameters(std::cout,
+                                 format == "json" ? dealii::ParameterHandler::JSON :
+                                                    dealii::ParameterHandler::PRM);
+          return 0;
+        }
+
+      if (preamble.dimension == 2)
+        run_scene<2>(prm, options);
+      else
+        run_scene<3>(prm, options);
+      return 0;
+    }
+
+    void
+    report(const std::string &kind, const std::string &message)
+    {
+      // Every rank sees the same error; one message is enough.
+      if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+        std::cerr << "hysteron: " << kind << ": " << message << std::endl;
+    }
+  } // namespace
+
+  int
+  run_application(int argc, char **argv)
+  {
+    try
+      {
+        return run(argc, argv);
+      }
+    catch (const InputError &e)
+      {
+        report("error", e.what());
+        return 1;
+      }
+    catch (const RuntimeError &e)
+      {
+        report("run-time error", e.what());
+        return 2;
+      }
+    catch (const dealii::ExceptionBase &e)
+      {
+        report("internal error", one_line(e));
+        return 3;
+      }
+    catch (const std::exception &e)
+      {
+        report("internal error", e.what());
+        return 3;
+      }
+  }
+} // namespace hysteron

@@ -1,0 +1,257 @@
+#include <deal.II/base/utilities.h>
+
+#include <hysteron/base/config.h>
+#include <hysteron/base/output.h>
+#include <hysteron/base/parameters.h>
+#include <hysteron/scene/scene.h>
+
+#include <sstream>
+
+namespace hysteron
+{
+  void
+  declare_preamble(dealii::ParameterHandler &prm)
+  {
+    using namespace dealii;
+    prm.declare_entry("Dimension",
+                      "2",
+                      Patterns::Integer(2, 3),
+                      "Space dimension of the scene: 2 or 3. Read before everything else.");
+    prm.declare_entry("Method",
+                      "material point",
+                      Patterns::Selection(Methods::Registry<3>::pattern_string()),
+                      "The method that runs the scene. Registered methods:" +
+                        Methods::Registry<3>::documentation());
+    prm.declare_entry("Material names",
+                      "",
+                      Patterns::List(Patterns::Anything()),
+                      "Names of further materials, besides the default one of `subsection "
+                      "Material`. Each name N gets its own `subsection Material N` with the same "
+                      "entries; bodies refer to materials by name.");
+    prm.declare_entry("Additional shared libraries",
+                      "",
+                      Patterns::List(Patterns::FileName()),
+                      "Shared libraries to load before the parameters are declared: user plugins "
+                      "(materials, methods) that register themselves. See "
+                      "doc/examples/custom_material.");
+  }
+
+  std::string
+  material_subsection(const std::string &name)
+  {
+    return name.empty() ? std::string("Material") : "Material " + name;
+  }
+
+  template <int dim>
+  void
+  Scene<dim>::declare_parameters(dealii::ParameterHandler       &prm,
+                                 const std::vector<std::string> &material_names)
+  {
+    using namespace dealii;
+    declare_preamble(prm);
+    prm.declare_entry("Random seed",
+                      "0",
+                      Patterns::Integer(0),
+                      "Seed of every random number generator (point sets, perturbations): the "
+                      "same seed gives the same results.");
+
+    prm.enter_subsection("Time");
+    {
+      prm.declare_entry("End time", "1", Patterns::Double(), "End of the simulation [s], > 0.");
+      prm.declare_entry("Time step",
+                        "0",
+                        Patterns::Double(),
+                        "Fixed time step [s], >= 0; 0 chooses it automatically from the CFL "
+                        "factor and the critical step of the method.");
+      prm.declare_entry("CFL factor",
+                        "0.5",
+                        Patterns::Double(),
+                        "Fraction of the critical time step used by automatic stepping, in (0, 1].");
+    }
+    prm.leave_subsection();
+
+    prm.enter_subsection("Output");
+    {
+      prm.declare_entry("Directory",
+                        "output",
+                        Patterns::DirectoryName(),
+                        "Directory for all results (created if missing). Relative paths are "
+                        "relative to the working directory.");
+      prm.declare_entry("Interval",
+                        "0",
+                        Patterns::Double(),
+                        "Simulated time between field outputs (VTU) and probe rows [s], >= 0; "
+                        "0 writes every step.");
+      prm.declare_entry("Write VTU",
+                        "true",
+                        Patterns::Bool(),
+                        "Write fields as VTU/PVD for ParaView (field methods only).");
+      prm.declare_entry("Probe points",
+                        "",
+                        Patterns::Anything(),
+                        "Points whose history is written to probes.csv, as 'x,y; x,y' in 2D or "
+                        "'x,y,z; ...' in 3D [m] (field methods only).");
+      prm.declare_entry("Progress interval",
+                        "2",
+                        Patterns::Double(),
+                        "Wall-clock seconds between progress lines, > 0 (silenced by --quiet).");
+    }
+    prm.leave_subsection();
+
+    std::vector<std::string> sections{""};
+    sections.insert(sections.end(), material_names.begin(), material_names.end());
+    for (const auto &name : sections)
+      {
+        prm.enter_subsection(material_subsection(name));
+        Material::declare_parameters(prm);
+        prm.leave_subsection();
+      }
+
+    Methods::Registry<3>::declare_parameters(prm);
+  }
+
+  namespace
+  {
+    template <int dim>
+    std::vector<dealii::Point<dim>>
+    parse_points(const std::string &text, const std::string &where)
+    {
+      std::vector<dealii::Point<dim>> points;
+      for (const auto &item : dealii::Utilities::split_string_list(text, ';'))
+        {
+          if (item.empty())
+            continue;
+          std::vector<double> coordinates;
+          try
+            {
+              coordinates =
+                dealii::Utilities::string_to_double(dealii::Utilities::split_string_list(item, ','));
+            }
+          catch (...)
+            {
+              throw InputError(where, "cannot read the point '" + item + "'");
+            }
+          require(coordinates.size() == dim,
+                  where,
+                  "the point '" + item + "' has " + std::to_string(coordinates.size()) +
+                    " coordinates; a " + std::to_string(dim) + "D scene needs " +
+                    std::to_string(dim));
+          dealii::Point<dim> p;
+          for (unsigned int d = 0; d < dim; ++d)
+            p[d] = coordinates[d];
+          points.push_back(p);
+        }
+      return points;
+    }
+  } // namespace
+
+  template <int dim>
+  Scene<dim>::Scene(dealii::ParameterHandler &prm, const RunOptions &options)
+    : options(options)
+    , pcout(std::cout, !options.quiet && dealii::Utilities::MPI::this_mpi_process(options.comm) == 0)
+    , computing_timer(options.comm, pcout, dealii::TimerOutput::never, dealii::TimerOutput::wall_times)
+  {
+    method_name = prm.get("Method");
+    seed        = prm.get_integer("Random seed");
+
+    {
+      Section s(prm, {"Time"});
+      time.end_time   = s.get_positive("End time");
+      time.time_step  = s.get_non_negative("Time step");
+      time.cfl_factor = s.get_positive("CFL factor");
+      require(time.cfl_factor <= 1.0,
+              s.where("CFL factor"),
+              "must be <= 1 (got " + s.get("CFL factor") + ")");
+    }
+    {
+      Section s(prm, {"Output"});
+      output.directory = dealii::Utilities::trim(s.get("Directory"));
+      require(!output.directory.empty(), s.where("Directory"), "must not be empty");
+      output.interval          = s.get_non_negative("Interval");
+      output.write_vtu         = s.get_bool("Write VTU");
+      output.probe_points      = parse_points<dim>(s.get("Probe points"), s.where("Probe points"));
+      output.progress_interval = s.get_positive("Progress interval");
+    }
+
+    std::vector<std::string> names{""};
+    const auto extra = parse_names(prm.get("Material names"), "Material names");
+    names.insert(names.end(), extra.begin(), extra.end());
+    for (const auto &name : names)
+      {
+        Section s(prm, {material_subsection(name)});
+        materials[name] = Material::create<dim>(s);
+      }
+
+    std::ostringstream text;
+    prm.print_parameters(text, dealii::ParameterHandler::ShortPRM);
+    effective_parameters = "# Parameters of this hysteron " HYSTERON_VERSION " run (" +
+                           options.parameter_file + "), defaults included.\n" + text.str();
+
+    method = Methods::Registry<dim>::create(method_name, "Method");
+    method->initialize(*this, prm);
+  }
+
+  template <int dim>
+  const Material::Interface<dim> &
+  Scene<dim>::material(const std::string &name, const std::string &where) const
+  {
+    const auto it = materials.find(name);
+    if (it == materials.end())
+      {
+        std::string known = "'' (the default `subsection Material`)";
+        for (const auto &m : materials)
+          if (!m.first.empty())
+            known += ", '" + m.first + "'";
+        throw InputError(where, "no material named '" + name + "'; known: " + known);
+      }
+    return *it->second;
+  }
+
+  template <int dim>
+  std::vector<std::string>
+  Scene<dim>::material_names() const
+  {
+    std::vector<std::string> names;
+    for (const auto &m : materials)
+      names.push_back(m.first);
+    return names;
+  }
+
+  template <int dim>
+  void
+  Scene<dim>::run()
+  {
+    // Directory problems are input errors; rank 0 decides, every rank reports.
+    std::string problem;
+    if (is_root())
+      try
+        {
+          Output::prepare_directory(output.directory, "Output/Directory");
+          Output::write_file(output_file("parameters.prm"), effective_parameters);
+        }
+      catch (const InputError &e)
+        {
+          problem = e.problem();
+        }
+    problem = dealii::Utilities::MPI::broadcast(options.comm, problem, 0);
+    if (!problem.empty())
+      throw InputError("Output/Directory", problem);
+
+    dealii::Timer wall;
+    wall.start();
+    pcout << "hysteron " HYSTERON_VERSION ": " << dim << "D scene '" << options.parameter_file
+          << "', method '" << method_name << "'" << std::endl;
+    method->run();
+    wall.stop();
+
+    pcout << "hysteron: '" << method_name << "' finished in " << wall.wall_time() << " s";
+    const std::string s = method->summary();
+    if (!s.empty())
+      pcout << " (" << s << ")";
+    pcout << ".\nResults are in " << output.directory << "/" << std::endl;
+    computing_timer.print_summary();
+  }
+
+  template class Scene<2>;
+  template class Scene<3>;
+} // namespace hysteron
