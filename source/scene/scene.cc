@@ -5,6 +5,7 @@
 #include <hysteron/base/parameters.h>
 #include <hysteron/scene/scene.h>
 
+#include <iostream>
 #include <sstream>
 
 namespace hysteron
@@ -180,6 +181,9 @@ namespace hysteron
       {
         Section s(prm, {material_subsection(name)});
         materials[name] = Material::create<dim>(s);
+        if (is_root())
+          for (const auto &w : materials[name]->warnings())
+            std::cerr << "hysteron: warning: " << w << std::endl;
       }
 
     std::ostringstream text;

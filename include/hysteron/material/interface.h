@@ -118,13 +118,28 @@ namespace hysteron
                    double                                &eps_zz,
                    double                                &sigma_zz) const;
 
+      /// Warnings found while reading the parameters (printed by the scene on rank 0).
+      const std::vector<std::string> &
+      warnings() const
+      {
+        return parse_warnings;
+      }
+
     protected:
       /// Read the model's own parameters (inside `subsection Material`).
       virtual void
       parse_parameters(const Section &section);
 
+      /// Record a warning ("Material/Bouc-Wen/Beta: ...") for the user.
+      void
+      add_warning(const std::string &warning)
+      {
+        parse_warnings.push_back(warning);
+      }
+
     private:
-      Elasticity elastic;
+      Elasticity               elastic;
+      std::vector<std::string> parse_warnings;
     };
 
     template <int dim>
