@@ -81,7 +81,7 @@ namespace hysteron
     {
       for (std::size_t i = 0; i < columns.size(); ++i)
         file.stream() << (i == 0 ? "" : ",") << columns[i];
-      file.stream() << '\n' << std::setprecision(12);
+      file.stream() << '\n' << std::setprecision(15);
     }
 
     void

@@ -326,11 +326,10 @@ namespace hysteron
       progress.finish(n_steps, end_time);
       timing.stop();
 
+      // Timer sections synchronise the ranks: every rank enters them.
+      dealii::TimerOutput::Scope output_timing(scene.timer(), "output");
       if (csv)
-        {
-          dealii::TimerOutput::Scope output_timing(scene.timer(), "output");
-          csv->commit();
-        }
+        csv->commit();
     }
 
     template <int dim>

@@ -64,7 +64,7 @@ namespace hysteron
     write_file(const std::string &filename, const std::string &content);
 
     /**
-     * A CSV table with a header line. Rows are written with 12 significant
+     * A CSV table with a header line. Rows are written with 15 significant
      * digits. The table is an AtomicFile: it appears under its name on commit().
      */
     class CsvWriter

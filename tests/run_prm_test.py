@@ -1,0 +1,194 @@
+#!/usr/bin/env python3
+"""Run one hysteron scene test: a .prm file whose comment lines carry its assertions.
+
+The scene runs in a fresh working directory (relative output paths land there) with
+--quiet. Directives, one per comment line:
+
+  # CHECK <file>: <expr>          holds on every data row of the CSV <file>
+  # CHECK-LAST <file>: <expr>     holds on the last row
+  # CHECK-COLUMNS <file>: <expr>  holds once, each column bound to the list of its values
+  # EXPECT-ERROR: <regex>         the run must fail (exit status 1, or the one of EXIT),
+                                  stderr must match <regex>, and no output file may be
+                                  left behind (no *.tmp, no CSV, no VTU)
+  # EXIT: <n>                     the expected non-zero exit status (with EXPECT-ERROR)
+  # EXPECT-STDERR: <regex>        stderr must match (e.g. a warning) on a successful run
+  # ARGS: <arguments>             command line instead of "--quiet <prm>" ({prm} = the file)
+  # MPI: 2                        also run on 2 ranks; every output file must be identical
+
+Expressions are Python over the CSV column names, with abs, sqrt, exp, log, tanh, sin, cos,
+pi, min, max, sum, len, all, any, and `i` (the row index) for CHECK.
+Exit status 0 when every assertion holds; the failures are printed otherwise.
+"""
+import argparse
+import csv
+import filecmp
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+SAFE = {
+    "abs": abs, "sqrt": math.sqrt, "exp": math.exp, "log": math.log, "tanh": math.tanh,
+    "sin": math.sin, "cos": math.cos, "pi": math.pi, "min": min, "max": max, "sum": sum,
+    "len": len, "all": all, "any": any, "range": range, "zip": zip, "math": math,
+}
+
+
+def parse_directives(path):
+    directives = []
+    pattern = re.compile(r"^\s*#\s*(CHECK-LAST|CHECK-COLUMNS|CHECK|EXPECT-ERROR|EXPECT-STDERR|EXIT|"
+                         r"ARGS|MPI)\b\s*([^:]*):\s?(.*)$")
+    with open(path) as f:
+        for line in f:
+            m = pattern.match(line)
+            if m:
+                directives.append((m.group(1), m.group(2).strip(), m.group(3).strip()))
+    return directives
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    if not rows:
+        raise AssertionError(f"{path} is empty")
+    header, data = rows[0], rows[1:]
+    values = [[float(x) for x in r] for r in data]
+    return header, values
+
+
+def run(cmd, cwd, env):
+    p = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=900)
+    return p.returncode, p.stdout, p.stderr
+
+
+def output_files(directory):
+    found = []
+    for root, _, files in os.walk(directory):
+        for name in files:
+            found.append(os.path.relpath(os.path.join(root, name), directory))
+    return sorted(found)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--hysteron", required=True)
+    ap.add_argument("--mpiexec", default="mpirun")
+    ap.add_argument("--workdir", required=True)
+    ap.add_argument("prm")
+    args = ap.parse_args()
+
+    prm = os.path.abspath(args.prm)
+    directives = parse_directives(prm)
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1")
+
+    shutil.rmtree(args.workdir, ignore_errors=True)
+    os.makedirs(args.workdir)
+    local_prm = os.path.join(args.workdir, os.path.basename(prm))
+    shutil.copy(prm, local_prm)
+
+    arg_line = next((v for k, _, v in directives if k == "ARGS"), "--quiet {prm}")
+    command = [args.hysteron] + [a.replace("{prm}", os.path.basename(prm))
+                                 for a in arg_line.split()]
+    failures = []
+
+    code, out, err = run(command, args.workdir, env)
+    print("$ " + " ".join(command))
+    if out:
+        print(out[-4000:])
+    if err:
+        print("stderr:\n" + err[-4000:])
+
+    expect_error = [v for k, _, v in directives if k == "EXPECT-ERROR"]
+    if expect_error:
+        expected_code = int(next((v for k, _, v in directives if k == "EXIT"), "1"))
+        if code != expected_code:
+            failures.append(f"exit status {code}, expected {expected_code}")
+        for regex in expect_error:
+            if not re.search(regex, err):
+                failures.append(f"stderr does not match /{regex}/")
+        if "Traceback" in err or "terminate called" in err or "Aborted" in err:
+            failures.append("the program crashed instead of reporting the error")
+        left = [f for f in output_files(args.workdir)
+                if f != os.path.basename(prm) and not f.endswith("parameters.prm")]
+        if left:
+            failures.append(f"output files left behind after a failed run: {left}")
+    else:
+        if code != 0:
+            failures.append(f"exit status {code}")
+        for k, _, v in directives:
+            if k == "EXPECT-STDERR" and not re.search(v, err):
+                failures.append(f"stderr does not match /{v}/")
+
+        for kind, target, expr in directives:
+            if kind not in ("CHECK", "CHECK-LAST", "CHECK-COLUMNS"):
+                continue
+            path = os.path.join(args.workdir, target)
+            try:
+                header, rows = read_csv(path)
+            except (OSError, ValueError, AssertionError) as e:
+                failures.append(f"{target}: cannot read: {e}")
+                continue
+            if not rows:
+                failures.append(f"{target}: no data rows")
+                continue
+            try:
+                if kind == "CHECK-COLUMNS":
+                    scope = dict(SAFE)
+                    scope.update({h: [r[j] for r in rows] for j, h in enumerate(header)})
+                    if not eval(expr, dict(scope, __builtins__={})):
+                        failures.append(f"{kind} {target}: {expr} is false")
+                else:
+                    selected = [(len(rows) - 1, rows[-1])] if kind == "CHECK-LAST" else \
+                        list(enumerate(rows))
+                    for i, r in selected:
+                        scope = dict(SAFE)
+                        scope.update(dict(zip(header, r)))
+                        scope["i"] = i
+                        if not eval(expr, dict(scope, __builtins__={})):
+                            shown = ", ".join(f"{h}={v:.6g}" for h, v in zip(header, r))
+                            failures.append(f"{kind} {target}: {expr} is false at row {i}: "
+                                            f"{shown[:600]}")
+                            break
+            except Exception as e:  # a broken expression is a failing test
+                failures.append(f"{kind} {target}: cannot evaluate {expr}: {e}")
+
+        for k, _, v in directives:
+            if k != "MPI":
+                continue
+            ranks = int(v)
+            mpi_dir = args.workdir + f".np{ranks}"
+            shutil.rmtree(mpi_dir, ignore_errors=True)
+            os.makedirs(mpi_dir)
+            shutil.copy(prm, mpi_dir)
+            mpi_command = [args.mpiexec, "-np", str(ranks)] + command
+            code2, out2, err2 = run(mpi_command, mpi_dir, env)
+            print("$ " + " ".join(mpi_command))
+            if code2 != 0:
+                failures.append(f"{ranks} ranks: exit status {code2}: {err2[-2000:]}")
+                continue
+            one, two = output_files(args.workdir), output_files(mpi_dir)
+            comparable = [f for f in one if f.endswith(".csv")]
+            for f in comparable:
+                if f not in two:
+                    failures.append(f"{ranks} ranks: {f} missing")
+                elif not filecmp.cmp(os.path.join(args.workdir, f), os.path.join(mpi_dir, f),
+                                     shallow=False):
+                    failures.append(f"{ranks} ranks: {f} differs from the 1-rank run")
+
+    n_checks = sum(1 for k, _, _ in directives
+                   if k in ("CHECK", "CHECK-LAST", "CHECK-COLUMNS", "EXPECT-ERROR", "MPI",
+                            "EXPECT-STDERR"))
+    if n_checks == 0 and not expect_error:
+        failures.append("the test has no assertion (add a CHECK, EXPECT-ERROR or MPI line)")
+    if failures:
+        print("FAILED:\n  " + "\n  ".join(failures))
+        return 1
+    print(f"passed ({n_checks} assertions)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
