@@ -5,6 +5,7 @@
 
 #include <hysteron/base/config.h>
 #include <hysteron/base/exceptions.h>
+#include <hysteron/base/parameter_documentation.h>
 #include <hysteron/base/parameters.h>
 #include <hysteron/scene/application.h>
 #include <hysteron/scene/scene.h>
@@ -20,7 +21,7 @@ namespace hysteron
   {
     const char *usage_text =
       "Usage: hysteron [--quiet] SCENE.prm\n"
-      "       hysteron --print-parameters [prm|json] [SCENE.prm]\n"
+      "       hysteron --print-parameters [prm|json|markdown] [SCENE.prm]\n"
       "       hysteron --help | --version\n"
       "\n"
       "Runs the scene described by the parameter file SCENE.prm: its `Dimension` (2 or 3) and\n"
@@ -29,7 +30,7 @@ namespace hysteron
       "Options:\n"
       "  --quiet              no progress, summary or timer table on stdout\n"
       "  --print-parameters   write every parameter with its default, allowed values and\n"
-      "                       documentation (PRM format, or JSON) and exit; with SCENE.prm,\n"
+      "                       documentation (PRM, JSON or Markdown) and exit; with SCENE.prm,\n"
       "                       the values of that file and its named materials\n"
       "  --help               this text\n"
       "  --version            the version\n"
@@ -132,7 +133,8 @@ namespace hysteron
             {
               print_parameters = true;
               if (i + 1 < argc && (std::string(argv[i + 1]) == "prm" ||
-                                   std::string(argv[i + 1]) == "json"))
+                                   std::string(argv[i + 1]) == "json" ||
+                                   std::string(argv[i + 1]) == "markdown"))
                 format = argv[++i];
             }
           else if (!arg.empty() && arg[0] == '-')
@@ -179,9 +181,15 @@ namespace hysteron
       if (print_parameters)
         {
           if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
-            prm.print_parameters(std::cout,
-                                 format == "json" ? dealii::ParameterHandler::JSON :
-                                                    dealii::ParameterHandler::PRM);
+            {
+              if (format == "json")
+                prm.print_parameters(std::cout, dealii::ParameterHandler::JSON);
+              else
+                print_parameter_documentation(prm,
+                                              std::cout,
+                                              format == "markdown" ? ParameterFormat::markdown :
+                                                                     ParameterFormat::prm);
+            }
           return 0;
         }
 
