@@ -12,6 +12,7 @@ The scene runs in a fresh working directory (relative output paths land there) w
                                   left behind (no *.tmp, no CSV, no VTU)
   # EXIT: <n>                     the expected non-zero exit status (with EXPECT-ERROR)
   # EXPECT-STDERR: <regex>        stderr must match (e.g. a warning) on a successful run
+  # EXPECT-STDOUT: <regex>        stdout must match on a successful run
   # ARGS: <arguments>             command line instead of "--quiet <prm>" ({prm} = the file)
   # MPI: 2                        also run on 2 ranks; every output file must be identical
 
@@ -38,7 +39,7 @@ SAFE = {
 
 def parse_directives(path):
     directives = []
-    pattern = re.compile(r"^\s*#\s*(CHECK-LAST|CHECK-COLUMNS|CHECK|EXPECT-ERROR|EXPECT-STDERR|EXIT|"
+    pattern = re.compile(r"^\s*#\s*(CHECK-LAST|CHECK-COLUMNS|CHECK|EXPECT-ERROR|EXPECT-STDERR|EXPECT-STDOUT|EXIT|"
                          r"ARGS|MPI)\b\s*([^:]*):\s?(.*)$")
     with open(path) as f:
         for line in f:
@@ -121,6 +122,8 @@ def main():
         for k, _, v in directives:
             if k == "EXPECT-STDERR" and not re.search(v, err):
                 failures.append(f"stderr does not match /{v}/")
+            if k == "EXPECT-STDOUT" and not re.search(v, out):
+                failures.append(f"stdout does not match /{v}/")
 
         for kind, target, expr in directives:
             if kind not in ("CHECK", "CHECK-LAST", "CHECK-COLUMNS"):
@@ -180,7 +183,7 @@ def main():
 
     n_checks = sum(1 for k, _, _ in directives
                    if k in ("CHECK", "CHECK-LAST", "CHECK-COLUMNS", "EXPECT-ERROR", "MPI",
-                            "EXPECT-STDERR"))
+                            "EXPECT-STDERR", "EXPECT-STDOUT"))
     if n_checks == 0 and not expect_error:
         failures.append("the test has no assertion (add a CHECK, EXPECT-ERROR or MPI line)")
     if failures:

@@ -11,6 +11,7 @@
 #include <hysteron/scene/scene.h>
 
 #include <dlfcn.h>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -93,6 +94,11 @@ namespace hysteron
     void
     check_readable(const std::string &file)
     {
+      std::error_code ec;
+      require(std::filesystem::exists(file, ec), file, "cannot open the parameter file: no such file");
+      require(std::filesystem::is_regular_file(file, ec),
+              file,
+              "cannot open the parameter file: not a regular file");
       std::ifstream in(file);
       require(static_cast<bool>(in), file, "cannot open the parameter file for reading");
     }
