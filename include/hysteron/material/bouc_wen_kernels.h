@@ -1,0 +1,1253 @@
+#ifndef hysteron_material_bouc_wen_kernels_h
+#define hysteron_material_bouc_wen_kernels_h
+
+#include <hysteron/base/exceptions.h>
+#include <hysteron/material/elasticity.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <sstream>
+
+namespace hysteron
+{
+  namespace Material
+  {
+    /**
+     * Point kernels of the triaxial Bouc-Wen law (class BoucWen). Everything here
+     * is a template on the stress state, the hardening kind and degradation, so
+     * that a batch pays for exactly the features its material uses: no virtual
+     * call, no allocation, fixed-size arrays only.
+     *
+     * <h3>Notation</h3>
+     * Inside the kernels symmetric tensors are Mandel vectors: normal components
+     * first, shear components multiplied by sqrt(2), in the order
+     * xx, yy, zz, xy, yz, xz (3D) or xx, yy, zz, xy (2D). Then A : B is the plain
+     * dot product, the deviatoric projector and the isotropic stiffness are
+     * symmetric matrices, and a Jacobian is an ordinary matrix. The tensor
+     * (not engineering) shear component is eps_xy = mandel_xy / sqrt(2); the
+     * conversion to SymmetricTensor happens only at the interface.
+     *
+     * Two vector lengths: F, the full relative stress / plastic strain (6 in 3D,
+     * 4 in 2D: the zz component exists in both plane states), and K, the
+     * components integrated with the stiffness D: K = F in 3D and plane strain
+     * (eps_zz' = 0, sigma_zz carried), K = 3 (xx, yy, xy) in plane stress, where D
+     * is the plane-stress stiffness and the flow vector enters D only through its
+     * in-plane part. The isotropic stiffness is D = lambda_eff 1 (x) 1 + 2 mu I on
+     * the normal components of the K vector (lambda_eff = E nu / (1 - nu^2) in
+     * plane stress), so that D v costs O(K).
+     *
+     * <h3>Derivation of the rate law</h3>
+     * Yield function Phi = q(sigma - alpha) - sigma_y(eps_iso), q the von Mises
+     * equivalent stress (homogeneous of degree 1), flow vector
+     * n = dq/dsigma = 3/2 dev(xi) / q, xi = sigma - alpha, so n : n = 3/2 (3D tensors,
+     * also in plane stress, where n_zz != 0) and n : xi = q. Associated flow
+     * eps_p' = lambda' n gives the equivalent plastic strain rate
+     * sqrt(2/3 eps_p' : eps_p') = |lambda'|. Mixed hardening: eps_iso' = m |lambda'|,
+     * sigma_y = sigma_y0 + H' eps_iso; alpha' = (1 - m) C_p eps_p' (Prager).
+     * Consistency Phi' = 0 with sigma' = D : (eps' - lambda' n):
+     *   n:D:eps' - lambda' n:D:n - (1 - m) C_p lambda' n:n - m H' lambda' = 0
+     *   => lambda' = lambda1 n:D:eps',  lambda1 = 1 / ((1 - m) 3/2 C_p + m H' + n:D:n),
+     * and with C_p = 2/3 H' the hardening part is (1 - m) H' + m H' = H' for every m
+     * (so Fig. 4.18 step 6 and eq. 4.51 agree once C_p = 2/3 H').
+     * Bouc-Wen smoothing: lambda' = H1 H2 lambda1 n:D:eps', H1 = (q / sigma_y)^n,
+     * H2 = beta + gamma sgn(n:D:eps'). Then
+     *   sigma' = D : eps' - H1 H2 lambda1 (D:n)(n:D:eps') = E_t : eps',
+     *   E_t = D - H1 H2 lambda1 (D:n) (x) (n:D)   (symmetric).
+     * With H1 H2 = 1: Phi' = (1 - H1 H2) n:D:eps' = 0, so q = sigma_y is an attractor
+     * and H1 <= 1 holds for the exact solution (beta + gamma = 1). Check, uniaxial
+     * stress, kinematic (m = 0): alpha = C_p eps_p, eps_p = eps_p,xx diag(1, -1/2, -1/2),
+     * q = |sigma - C_p 3/2 eps_p,xx| = |sigma - H' eps_p,xx|; on yield
+     * d sigma = H' d eps_p and d eps = d sigma / E + d eps_p, so
+     * E_t = E H' / (E + H') = a E. With beta > gamma, H2 > 0 while unloading and
+     * lambda' < 0: eps_ps' = |lambda'| keeps the equivalent plastic strain increasing.
+     *
+     * Since alpha' = (1 - m) C_p eps_p' with a constant factor and both start at
+     * zero, alpha = (1 - m) C_p eps_p at all times (every Runge-Kutta method and
+     * backward Euler preserve this linear invariant): the kernels integrate eps_p
+     * and derive alpha from it.
+     *
+     * <h3>Degradation (eq. 2.46 with the project's dimensionless convention)</h3>
+     *   sigma' = D : (eps'/eta - lambda' n),  lambda' = nu_s H1 H2 lambda1 n:D:eps' / eta,
+     * i.e. eta scales the whole rate: the undegraded law is driven by the reduced
+     * strain rate eps'/eta (elastic and post-yield stiffness both divided by eta,
+     * the yield surface unchanged), which reproduces
+     * sigma' = (1/eta) D (I - nu_s H1 H2 R) eps'. The plastic strain, the back stress
+     * (alpha = (1 - m) C_p eps_p), the isotropic hardening (eps_iso = m eps_ps) and the
+     * consistency condition all refer to this reduced strain: with nu_s = 1 and
+     * H1 H2 = 1, Phi' = n:D:eps'/eta - lambda' (n:D:n + H') = 0 as before; nu_s > 1
+     * makes the surface q = sigma_y nu_s^(-1/n) the attractor (strength loss).
+     * Intrinsic time xi' = eps_ps' (strain units); eta' = c_eta eta^(-m_u) xi' with
+     * eta(0) = 1 integrates in closed form:
+     *   eta = (1 + (m_u + 1) c_eta eps_ps)^(1 / (m_u + 1)),
+     * so eta is a function of eps_ps (no ODE, no drift). Dissipated energy density
+     * e_h' = sigma : eps_p' = lambda' sigma:n [J/m^3] (eq. 2.44),
+     * nu_s = 1 + c_nu e_h / (sigma_y0 eps_y), eps_y = sigma_y0 / E.
+     * e_h includes the recoverable energy of the back stress (sigma : eps_p' =
+     * (sigma - alpha) : eps_p' + alpha : eps_p'), so under kinematic hardening it can
+     * dip slightly early in a reloading, where alpha : n < 0 and H1 is still small.
+     * Plane stress: the out-of-plane strain is not a function of the state when
+     * eta varies: eps_zz' = eta (-nu/E (sigma_xx' + sigma_yy') + eps_p,zz') is
+     * integrated (slot "epsilon_zz"); without degradation
+     * eps_zz = -nu/E (sigma_xx + sigma_yy) + eps_p,zz exactly.
+     *
+     * <h3>Plane stress: reduced forms</h3>
+     * As in the dissertation (Fig. 4.18), plane stress uses D_ps, the in-plane part
+     * n_p of n and lambda1 = 1 / (H' + n_p:D_ps:n_p), while the hardening terms use the
+     * 3D n : n = 3/2. This is the static condensation of the 3D law with
+     * sigma_zz' = 0 only where H1 H2 is 0 or 1: condensing the smooth 3D law gives
+     *   1 / lambda1 = H' + n:D:n - H1 H2 (n:D:n - n_p:D_ps:n_p).
+     * The two agree in the elastic range and on the plateau and differ in the knee
+     * (0.25 % of sigma_y at n = 8, 0.07 % at n = 32 on a multiaxial cyclic path).
+     *
+     * <h3>Integrators</h3>
+     * Rate independence: over one increment deps the rates are integrated in the
+     * pseudo time s in [0, 1] with eps' = deps.
+     * - forward Euler: y1 = y0 + f(y0) (Fig. 4.18 with eq. 4.51), tangent E_t(y0).
+     * - adaptive: Bogacki-Shampine 3(2), FSAL, first trying h = 1, error norm
+     *   max |err_i| / scale_i with scales sigma_y0 (stresses), eps_y (strains),
+     *   sigma_y0 eps_y (e_h), step factor 0.9 (tol/err)^(1/3) in [0.2, 5]; a
+     *   non-finite trial step (overflow of (q/sigma_y)^n in a too long step) is
+     *   shortened; at most Constants::max_substeps attempts, then RuntimeError. At
+     *   the end of the increment a drift correction (see drift_correction()) keeps
+     *   nu_s H1 <= 1 (exact solutions do), which an explicit method near its stability
+     *   limit on the stiff relaxation towards q = sigma_y otherwise misses by a few
+     *   tolerances for large n. Tangent: E_t at the end state (sign of the current
+     *   increment).
+     * - backward Euler: rates at the end of the increment, H2 frozen from the
+     *   trial direction sgn(n_tr : D : deps), n_tr at sigma0 + D deps/eta0 - alpha0
+     *   (in 3D / plane strain without degradation n_tr is exactly the end-state
+     *   direction, radial return, so this is the fully implicit H2; it also treats a
+     *   reversal that crosses the surface within the increment as loading). 3D and
+     *   plane strain without degradation, loading: one scalar Newton equation
+     *   (radial_return()); otherwise Newton on (sigma, w[, dlambda, e_h]) with the
+     *   analytic Jacobian, scaled unknowns and backtracking (backward_euler()). The
+     *   consistent tangent follows from the implicit function theorem.
+     */
+    namespace BoucWenKernels
+    {
+      constexpr double sqrt2 = 1.41421356237309504880;
+
+      /// Everything a kernel needs, precomputed once per material.
+      struct Constants
+      {
+        double       E = 1, nu = 0;
+        double       two_mu = 1, lambda_eff = 0; ///< D = lambda_eff 1 (x) 1 + 2 mu I
+        double       sigma_y0 = 1, eps_y = 1;
+        double       H     = 0; ///< H' = a E / (1 - a)
+        double       kin   = 0; ///< (1 - m) C_p: alpha = kin eps_p
+        double       kin_q = 0; ///< 3/2 kin = (1 - m) H'
+        double       iso   = 0; ///< m H': sigma_y = sigma_y0 + iso eps_ps
+        double       n = 8, beta = 0.5, gamma = 0.5;
+        unsigned int n_integer = 8; ///< n if n is an integer in [1, 1024], else 0
+        double       c_eta = 0, m_u = 1, inv_m_u1 = 0.5; ///< 1 / (m_u + 1)
+        double       c_nu_scaled  = 0;                   ///< c_nu / (sigma_y0 eps_y)
+        double       tol          = 1e-6;
+        double       inv_sigma_y0 = 1, inv_eps_y = 1, inv_energy = 1;
+        unsigned int max_substeps   = 100000;
+        unsigned int max_iterations = 50;
+      };
+
+      template <StressState S>
+      struct Geometry;
+
+      template <>
+      struct Geometry<StressState::three_dimensional>
+      {
+        static constexpr int          dim      = 3;
+        static constexpr unsigned int F        = 6;
+        static constexpr unsigned int K        = 6;
+        static constexpr unsigned int n_normal = 3; ///< normal components of the K vector
+        static constexpr std::array<unsigned int, K> full = {{0, 1, 2, 3, 4, 5}};
+      };
+
+      template <>
+      struct Geometry<StressState::plane_strain>
+      {
+        static constexpr int                         dim      = 2;
+        static constexpr unsigned int                F        = 4;
+        static constexpr unsigned int                K        = 4;
+        static constexpr unsigned int                n_normal = 3;
+        static constexpr std::array<unsigned int, K> full     = {{0, 1, 2, 3}};
+      };
+
+      template <>
+      struct Geometry<StressState::plane_stress>
+      {
+        static constexpr int                         dim      = 2;
+        static constexpr unsigned int                F        = 4;
+        static constexpr unsigned int                K        = 3;
+        static constexpr unsigned int                n_normal = 2;
+        static constexpr std::array<unsigned int, K> full     = {{0, 1, 3}};
+      };
+
+      /// Tensor indices of the full component f (2D: f = 2 is zz, f = 3 is xy).
+      template <int dim>
+      constexpr std::array<unsigned int, 2>
+      tensor_index(const unsigned int f)
+      {
+        if (dim == 3)
+          {
+            constexpr unsigned int i[6] = {0, 1, 2, 0, 1, 0}, j[6] = {0, 1, 2, 1, 2, 2};
+            return {{i[f], j[f]}};
+          }
+        constexpr unsigned int i[4] = {0, 1, 2, 0}, j[4] = {0, 1, 2, 1};
+        return {{i[f], j[f]}};
+      }
+
+      /// Mandel weight of the full component f: 1 (normal) or sqrt(2) (shear).
+      constexpr double
+      mandel_weight(const unsigned int f)
+      {
+        return f < 3 ? 1.0 : sqrt2;
+      }
+
+      /// LU factorization with partial pivoting (LAPACK style: P A = L U, whole rows
+      /// swapped) of the row-major M x M matrix A, in place; false if singular.
+      template <unsigned int M>
+      bool
+      lu_factorize(std::array<double, M * M> &A, std::array<unsigned int, M> &pivot)
+      {
+        for (unsigned int k = 0; k < M; ++k)
+          {
+            unsigned int p = k;
+            for (unsigned int r = k + 1; r < M; ++r)
+              if (std::abs(A[r * M + k]) > std::abs(A[p * M + k]))
+                p = r;
+            pivot[k] = p;
+            if (!(std::abs(A[p * M + k]) > 0) || !std::isfinite(A[p * M + k]))
+              return false;
+            if (p != k)
+              for (unsigned int c = 0; c < M; ++c)
+                std::swap(A[k * M + c], A[p * M + c]);
+            const double inv = 1.0 / A[k * M + k];
+            for (unsigned int r = k + 1; r < M; ++r)
+              {
+                const double f = (A[r * M + k] *= inv);
+                for (unsigned int c = k + 1; c < M; ++c)
+                  A[r * M + c] -= f * A[k * M + c];
+              }
+          }
+        return true;
+      }
+
+      /// Solve A x = b in place with the factors of lu_factorize().
+      template <unsigned int M>
+      void
+      lu_solve(const std::array<double, M * M>   &LU,
+               const std::array<unsigned int, M> &pivot,
+               double                            *b)
+      {
+        // The factorization swapped whole rows (L included): permute b first.
+        for (unsigned int k = 0; k < M; ++k)
+          std::swap(b[k], b[pivot[k]]);
+        for (unsigned int k = 0; k < M; ++k)
+          for (unsigned int r = k + 1; r < M; ++r)
+            b[r] -= LU[r * M + k] * b[k];
+        for (int k = M - 1; k >= 0; --k)
+          {
+            double s = b[k];
+            for (unsigned int c = k + 1; c < M; ++c)
+              s -= LU[k * M + c] * b[c];
+            b[k] = s / LU[k * M + k];
+          }
+      }
+
+      /// max(a, b) that propagates a NaN in b (std::max would drop it).
+      inline double
+      max_nan(const double a, const double b)
+      {
+        return (b > a || b != b) ? b : a;
+      }
+
+      /// x^n, by repeated squaring when n is a small integer (std::pow is several
+      /// times slower, and H1 is evaluated at every stage).
+      inline double
+      power(const Constants &c, const double x)
+      {
+        if (c.n_integer == 0)
+          return std::pow(x, c.n);
+        double       result = 1, base = x;
+        unsigned int e = c.n_integer;
+        while (true)
+          {
+            if (e & 1u)
+              result *= base;
+            e >>= 1;
+            if (e == 0)
+              return result;
+            base *= base;
+          }
+      }
+
+      inline double
+      sign(const double x)
+      {
+        return (x > 0) ? 1.0 : ((x < 0) ? -1.0 : 0.0);
+      }
+
+      /**
+       * The law for one configuration. Explicit integrators work on the vector
+       * y = (sigma [K], eps_p [F], eps_ps, e_h (degradation), eps_zz (plane
+       * stress with degradation)); backward Euler on its own unknowns.
+       */
+      template <StressState S, bool kinematic, bool degrading>
+      struct Law
+      {
+        using G                                    = Geometry<S>;
+        static constexpr unsigned int K            = G::K;
+        static constexpr unsigned int F            = G::F;
+        static constexpr unsigned int n_nor        = G::n_normal;
+        static constexpr bool         track_eps_zz = degrading && S == StressState::plane_stress;
+        static constexpr bool         is_kinematic = kinematic;
+        static constexpr bool         is_degrading = degrading;
+
+        static constexpr unsigned int i_epsp   = K;
+        static constexpr unsigned int i_eps_ps = K + F;
+        static constexpr unsigned int i_e_h    = K + F + 1;
+        static constexpr unsigned int i_eps_zz = i_e_h + (degrading ? 1 : 0);
+        static constexpr unsigned int N        = i_eps_zz + (track_eps_zz ? 1 : 0);
+
+        using VecK = std::array<double, K>;
+        using VecF = std::array<double, F>;
+        using VecN = std::array<double, N>;
+        using MatK = std::array<std::array<double, K>, K>;
+
+        /// The stored state: named slots (see BoucWen::state_variable_names()).
+        struct Slots
+        {
+          static constexpr unsigned int H1       = 0;
+          static constexpr unsigned int H2       = 1;
+          static constexpr unsigned int eps_ps   = 2;
+          static constexpr unsigned int epsp     = 3;        ///< F tensor components
+          static constexpr unsigned int alpha    = epsp + F; ///< F components, kinematic only
+          static constexpr unsigned int sigma_zz = alpha + (kinematic ? F : 0); ///< plane strain
+          static constexpr unsigned int e_h =
+            sigma_zz + (S == StressState::plane_strain ? 1 : 0); ///< degradation: e_h, eta, nu_s
+          static constexpr unsigned int eta    = e_h + 1;
+          static constexpr unsigned int nu_s   = e_h + 2;
+          static constexpr unsigned int eps_zz = e_h + (degrading ? 3 : 0); ///< plane stress
+          static constexpr unsigned int size   = eps_zz + (track_eps_zz ? 1 : 0);
+        };
+
+        /// out = D v (K vectors).
+        static void
+        apply_D(const Constants &c, const double *v, double *out)
+        {
+          double tr = 0;
+          for (unsigned int a = 0; a < n_nor; ++a)
+            tr += v[a];
+          for (unsigned int a = 0; a < K; ++a)
+            out[a] = c.two_mu * v[a] + (a < n_nor ? c.lambda_eff * tr : 0.0);
+        }
+
+        static double
+        D_entry(const Constants &c, const unsigned int a, const unsigned int b)
+        {
+          return (a == b ? c.two_mu : 0.0) + (a < n_nor && b < n_nor ? c.lambda_eff : 0.0);
+        }
+
+        template <unsigned int L>
+        static double
+        dot(const double *a, const double *b)
+        {
+          double s = 0;
+          for (unsigned int i = 0; i < L; ++i)
+            s += a[i] * b[i];
+          return s;
+        }
+
+        /// dev(xi), xi = embed(sigma) - alpha (alpha = nullptr: none); returns q.
+        static double
+        relative_deviator(const double *sigma, const double *alpha, VecF &dev)
+        {
+          VecF xi{};
+          for (unsigned int a = 0; a < K; ++a)
+            xi[G::full[a]] = sigma[a];
+          if (alpha)
+            for (unsigned int f = 0; f < F; ++f)
+              xi[f] -= alpha[f];
+          const double p = (xi[0] + xi[1] + xi[2]) / 3.0;
+          dev            = xi;
+          dev[0] -= p;
+          dev[1] -= p;
+          dev[2] -= p;
+          return std::sqrt(1.5 * dot<F>(dev.data(), dev.data()));
+        }
+
+        /// eta(eps_ps) = (1 + (m_u + 1) c_eta eps_ps)^(1/(m_u + 1)), the closed-form
+        /// solution of eta' = c_eta eta^(-m_u) eps_ps', eta(0) = 1.
+        static double
+        eta_of(const Constants &c, const double eps_ps)
+        {
+          if (!degrading || c.c_eta == 0)
+            return 1.0;
+          return std::pow(1.0 + c.c_eta * eps_ps / c.inv_m_u1, c.inv_m_u1);
+        }
+
+        static double
+        H1_of(const Constants &c, const double q, const double sigma_y)
+        {
+          return q > 0 ? power(c, q / sigma_y) : 0.0;
+        }
+
+        /// What a rate evaluation knows besides the rates.
+        struct Rates
+        {
+          VecF   n;
+          VecK   Dn;
+          double q = 0, sigma_y = 1, H1 = 0, H2 = 0, lambda1 = 0, eta = 1, nu = 1;
+        };
+
+        /// dy = f(y) for the strain increment deps (De = D deps).
+        static void
+        rates(const Constants &c, const double *y, const VecK &De, double *dy, Rates &r)
+        {
+          VecF alpha;
+          if (kinematic)
+            for (unsigned int f = 0; f < F; ++f)
+              alpha[f] = c.kin * y[i_epsp + f];
+          VecF dev;
+          r.q       = relative_deviator(y, kinematic ? alpha.data() : nullptr, dev);
+          r.sigma_y = c.sigma_y0 + c.iso * y[i_eps_ps];
+          if (degrading)
+            {
+              r.eta = eta_of(c, y[i_eps_ps]);
+              r.nu  = 1.0 + c.c_nu_scaled * y[i_e_h];
+            }
+          double lambda_rate = 0;
+          if (r.q > 0)
+            {
+              const double inv_q = 1.5 / r.q;
+              for (unsigned int f = 0; f < F; ++f)
+                r.n[f] = inv_q * dev[f];
+              VecK n_K;
+              for (unsigned int a = 0; a < K; ++a)
+                n_K[a] = r.n[G::full[a]];
+              apply_D(c, n_K.data(), r.Dn.data());
+              const double nDn = dot<K>(n_K.data(), r.Dn.data());
+              const double nDe = dot<K>(n_K.data(), De.data());
+              r.H1             = H1_of(c, r.q, r.sigma_y);
+              r.H2             = c.beta + c.gamma * sign(nDe);
+              r.lambda1        = 1.0 / (c.H + nDn);
+              lambda_rate      = r.nu * r.H1 * r.H2 * r.lambda1 * nDe / r.eta;
+            }
+          else
+            {
+              r.n.fill(0.0);
+              r.Dn.fill(0.0);
+              r.H1      = 0;
+              r.H2      = c.beta;
+              r.lambda1 = 0;
+            }
+          const double inv_eta = 1.0 / r.eta;
+          for (unsigned int a = 0; a < K; ++a)
+            dy[a] = De[a] * inv_eta - lambda_rate * r.Dn[a];
+          for (unsigned int f = 0; f < F; ++f)
+            dy[i_epsp + f] = lambda_rate * r.n[f];
+          dy[i_eps_ps] = std::abs(lambda_rate);
+          if (degrading)
+            {
+              double sn = 0;
+              for (unsigned int a = 0; a < K; ++a)
+                sn += y[a] * r.n[G::full[a]];
+              dy[i_e_h] = lambda_rate * sn;
+            }
+          if (track_eps_zz)
+            dy[i_eps_zz] = r.eta * (-c.nu / c.E * (dy[0] + dy[1]) + dy[i_epsp + 2]);
+        }
+
+        /// E_t = (D - nu_s H1 H2 lambda1 (D n) (x) (D n)) / eta (eq. 2.47, Mandel).
+        static void
+        continuum_tangent(const Constants &c, const Rates &r, MatK &T)
+        {
+          const double f = r.nu * r.H1 * r.H2 * r.lambda1;
+          for (unsigned int a = 0; a < K; ++a)
+            for (unsigned int b = 0; b < K; ++b)
+              T[a][b] = (D_entry(c, a, b) - f * r.Dn[a] * r.Dn[b]) / r.eta;
+        }
+
+        /// H1 at the state y.
+        static double
+        H1_at(const Constants &c, const double *y)
+        {
+          VecF alpha, dev;
+          if (kinematic)
+            for (unsigned int f = 0; f < F; ++f)
+              alpha[f] = c.kin * y[i_epsp + f];
+          const double q = relative_deviator(y, kinematic ? alpha.data() : nullptr, dev);
+          return H1_of(c, q, c.sigma_y0 + c.iso * y[i_eps_ps]);
+        }
+
+        /// One explicit step over the whole increment; r: the rates at the start.
+        static void
+        forward_euler(const Constants &c, VecN &y, const VecK &deps, Rates &r)
+        {
+          VecK De;
+          apply_D(c, deps.data(), De.data());
+          VecN dy;
+          rates(c, y.data(), De, dy.data(), r);
+          for (unsigned int i = 0; i < N; ++i)
+            y[i] += dy[i];
+        }
+
+        /// Scaled error norm (max norm) of an embedded estimate (<= 1: accept).
+        static double
+        error_norm(const Constants &c, const VecN &err)
+        {
+          double e = 0;
+          for (unsigned int a = 0; a < K; ++a)
+            e = max_nan(e, std::abs(err[a]) * c.inv_sigma_y0);
+          for (unsigned int i = K; i <= i_eps_ps; ++i)
+            e = max_nan(e, std::abs(err[i]) * c.inv_eps_y);
+          if (degrading)
+            e = max_nan(e, std::abs(err[i_e_h]) * c.inv_energy);
+          if (track_eps_zz)
+            e = max_nan(e, std::abs(err[i_eps_zz]) * c.inv_eps_y);
+          return e / c.tol;
+        }
+
+        /// The plastic correction y -> y + dlambda (-D n, n, 1, sigma:n, ...) along
+        /// the flow direction n of @p r (linear in dlambda; sigma + D eps_p unchanged).
+        static void
+        plastic_correction(const Constants &c, VecN &y, const Rates &r, const double dlambda)
+        {
+          double sn = 0;
+          for (unsigned int a = 0; a < K; ++a)
+            sn += y[a] * r.n[G::full[a]];
+          const double s0 = y[0], s1 = y[1];
+          for (unsigned int a = 0; a < K; ++a)
+            y[a] -= dlambda * r.Dn[a];
+          for (unsigned int f = 0; f < F; ++f)
+            y[i_epsp + f] += dlambda * r.n[f];
+          y[i_eps_ps] += std::abs(dlambda);
+          if (degrading)
+            y[i_e_h] += dlambda * sn;
+          if (track_eps_zz)
+            y[i_eps_zz] += r.eta * (-c.nu / c.E * (y[0] - s0 + y[1] - s1) + dlambda * r.n[2]);
+        }
+
+        /**
+         * Drift correction (Sloan et al. 2001): the exact solution keeps
+         * nu_s H1 <= 1 (Phi' = n:D:eps'/eta (1 - nu_s H1 H2)), but an explicit
+         * method near its stability limit on this stiff relaxation (rate ~ n E deps /
+         * sigma_y) settles slightly outside. If nu_s H1 > 1 at the end of an
+         * increment, return to q = q* = sigma_y nu_s^(-1/n) along the flow direction
+         * by Newton's method on q - q* in dlambda (one step is exact in 3D and plane
+         * strain without degradation, where D n = 2 mu n). The correction is of the
+         * size of the local error. Updates r.q, r.sigma_y, r.nu and r.H1.
+         */
+        static void
+        drift_correction(const Constants &c, VecN &y, Rates &r)
+        {
+          for (unsigned int iteration = 0; iteration < 5; ++iteration)
+            {
+              const double scale  = degrading ? std::pow(r.nu, -1.0 / c.n) : 1.0;
+              const double target = r.sigma_y * scale;
+              if (!(r.q > target * (1 + 1e-14)) || r.lambda1 == 0)
+                break;
+              // d(q - q*)/d dlambda = -(n:D:n + (1 - m) H' + m H' nu^(-1/n))
+              //                       + q* / (n nu) c_nu sigma:n / (sigma_y0 eps_y)
+              double slope = 1.0 / r.lambda1 - c.H + c.kin_q + c.iso * scale;
+              if (degrading)
+                {
+                  double sn = 0;
+                  for (unsigned int a = 0; a < K; ++a)
+                    sn += y[a] * r.n[G::full[a]];
+                  slope -= target / (c.n * r.nu) * c.c_nu_scaled * sn;
+                }
+              if (!(slope > 0))
+                break;
+              plastic_correction(c, y, r, (r.q - target) / slope);
+              VecF alpha, dev;
+              if (kinematic)
+                for (unsigned int f = 0; f < F; ++f)
+                  alpha[f] = c.kin * y[i_epsp + f];
+              r.q       = relative_deviator(y.data(), kinematic ? alpha.data() : nullptr, dev);
+              r.sigma_y = c.sigma_y0 + c.iso * y[i_eps_ps];
+              if (degrading)
+                r.nu = 1.0 + c.c_nu_scaled * y[i_e_h];
+              r.H1 = H1_of(c, r.q, r.sigma_y);
+            }
+        }
+
+        /**
+         * Bogacki-Shampine 3(2) with first-same-as-last and error control over the
+         * pseudo time s in [0, 1]; r: the rates at the end state. Returns the
+         * number of attempted sub-steps.
+         */
+        static unsigned int
+        adaptive(const Constants &c, VecN &y, const VecK &deps, Rates &r)
+        {
+          VecK De;
+          apply_D(c, deps.data(), De.data());
+          VecN  k1, k2, k3, k4, yt, y_new, err;
+          Rates r_stage, r_new;
+          rates(c, y.data(), De, k1.data(), r);
+          double       s = 0, h = 1;
+          unsigned int attempts = 0;
+          while (true)
+            {
+              if (++attempts > c.max_substeps)
+                {
+                  std::ostringstream m;
+                  m << "Bouc-Wen (adaptive integrator): more than " << c.max_substeps
+                    << " sub-steps for one strain increment (reached s = " << s << ", sub-step "
+                    << h << ", H1 = " << r.H1
+                    << "). Reduce the strain increment or raise Material/Bouc-Wen/Tolerance.";
+                  throw RuntimeError(m.str());
+                }
+              const bool last = (s + h >= 1.0);
+              if (last)
+                h = 1.0 - s;
+              for (unsigned int i = 0; i < N; ++i)
+                yt[i] = y[i] + 0.5 * h * k1[i];
+              rates(c, yt.data(), De, k2.data(), r_stage);
+              for (unsigned int i = 0; i < N; ++i)
+                yt[i] = y[i] + 0.75 * h * k2[i];
+              rates(c, yt.data(), De, k3.data(), r_stage);
+              for (unsigned int i = 0; i < N; ++i)
+                y_new[i] = y[i] + h * (2.0 / 9.0 * k1[i] + 1.0 / 3.0 * k2[i] + 4.0 / 9.0 * k3[i]);
+              rates(c, y_new.data(), De, k4.data(), r_new);
+              for (unsigned int i = 0; i < N; ++i)
+                err[i] = h * (-5.0 / 72.0 * k1[i] + 1.0 / 12.0 * k2[i] + 1.0 / 9.0 * k3[i] -
+                              0.125 * k4[i]);
+              const double e = error_norm(c, err);
+              if (!std::isfinite(e))
+                {
+                  // Overflow in a too long trial step (H1 = (q/sigma_y)^n explodes for
+                  // large n): shorten it; a non-finite start is an error.
+                  bool finite = true;
+                  for (unsigned int i = 0; i < N; ++i)
+                    finite = finite && std::isfinite(y[i]) && std::isfinite(k1[i]);
+                  if (!finite)
+                    {
+                      std::ostringstream m;
+                      m << "Bouc-Wen (adaptive integrator): non-finite rates at s = " << s
+                        << " of a strain increment (stress, state or increment not finite)";
+                      throw RuntimeError(m.str());
+                    }
+                  h *= 0.1;
+                }
+              else if (e <= 1.0)
+                {
+                  y  = y_new;
+                  k1 = k4;
+                  r  = r_new;
+                  if (last)
+                    {
+                      drift_correction(c, y, r);
+                      return attempts;
+                    }
+                  s += h;
+                  h *= (e > 0) ? std::min(5.0, 0.9 / std::cbrt(e)) : 5.0;
+                }
+              else
+                h *= std::max(0.2, 0.9 / std::cbrt(e));
+              if (h < 1e-13)
+                {
+                  std::ostringstream m;
+                  m << "Bouc-Wen (adaptive integrator): the sub-step fell below 1e-13 of the "
+                       "increment at s = "
+                    << s << " (H1 = " << r.H1
+                    << "): the tolerance cannot be met in double precision. Raise "
+                       "Material/Bouc-Wen/Tolerance.";
+                  throw RuntimeError(m.str());
+                }
+            }
+        }
+
+        // ---------------------------------------------------------------
+        // Backward Euler
+        // ---------------------------------------------------------------
+        /**
+         * Unknowns x = (sigma [K], w, dlambda, e_h), the last two only with
+         * degradation; w = H1^(1/n) = q1 / sigma_y1 (the Bouc-Wen relation in
+         * "root" form), dlambda = c w^n with c = nu1 H2 lambda1(n1) n1:D:deps / eta1.
+         * With alpha1 = alpha0 + kin dlambda n1 the end-state relative stress is
+         * xi - kin dlambda n1 (xi = sigma - alpha0), whose deviator is parallel to
+         * dev(xi); hence n1 = n(xi) and q1 = q(xi) - (1 - m) H' dlambda. Residuals:
+         *   R_sigma   = sigma - sigma0 - D deps / eta1 + dlambda D n1
+         *   R_w       = q1 / sigma_y1 - w,   sigma_y1 = sigma_y0 + m H' (eps_ps0 + |dlambda|)
+         *   R_dlambda = dlambda - c w^n            (degradation; else dlambda := c w^n)
+         *   R_e       = e_h - e_h0 - dlambda sigma : n1
+         * The root form is concave in w: Newton from w0 = min(1, q_trial / sigma_y)
+         * (right of the root) converges monotonically for every n, also n = 100,
+         * where the form dlambda - c H1 needs O(n) iterations.
+         */
+        static constexpr unsigned int M    = K + 1 + (degrading ? 2 : 0);
+        static constexpr unsigned int i_w  = K;
+        static constexpr unsigned int i_dl = K + 1;
+        static constexpr unsigned int i_eh = K + 2;
+        using VecM                         = std::array<double, M>;
+        using MatM                         = std::array<double, M * M>;
+
+        struct BEData
+        {
+          VecK   sigma0, De;
+          VecF   alpha0;
+          double eps_ps0 = 0, e_h0 = 0, H2 = 1, s_lambda = 1;
+          /// Upper bound of w for Newton iterates (see backward_euler()). Backward Euler
+          /// solutions have w <= max(1, q_tr / sigma_y) up to the non-radiality of plane
+          /// stress; with beta > gamma the equations also have spurious roots in the
+          /// run-away regime nu_s H1 (beta - gamma) > 1 (reverse flow pushing the stress
+          /// outwards), which the bound keeps Newton away from.
+          double w_cap = 2;
+        };
+
+        /// End-state quantities of an iterate.
+        struct Iterate
+        {
+          VecF   n;
+          VecK   n_K, Dn;
+          double q1 = 0, sigma_y1 = 1, eta1 = 1, dlambda = 0, c = 0, wn = 0, gw = 0, lambda1 = 0;
+          double nu1 = 1, H2 = 1;
+        };
+
+        static void
+        evaluate(const Constants &c, const BEData &d, const VecM &x, VecM &R, MatM *J, Iterate &it)
+        {
+          const double *sigma = x.data();
+          VecF          dev;
+          const double  qt = relative_deviator(sigma, kinematic ? d.alpha0.data() : nullptr, dev);
+          const double  inv_q = qt > 0 ? 1.5 / qt : 0.0;
+          for (unsigned int f = 0; f < F; ++f)
+            it.n[f] = inv_q * dev[f];
+          for (unsigned int a = 0; a < K; ++a)
+            it.n_K[a] = it.n[G::full[a]];
+          apply_D(c, it.n_K.data(), it.Dn.data());
+          const double nDn = dot<K>(it.n_K.data(), it.Dn.data());
+          const double nDe = dot<K>(it.n_K.data(), d.De.data());
+          it.lambda1       = 1.0 / (c.H + nDn);
+          // H2 of the iterate (fully implicit): H2 n:D:deps = beta n:D:deps +
+          // gamma |n:D:deps| is continuous, so the residual is semismooth and its
+          // derivative is H2 d(n:D:deps) away from the kink.
+          it.H2 = c.beta + c.gamma * sign(nDe);
+
+          const double w = x[i_w];
+          it.wn          = power(c, w);
+          double deta    = 0; // d eta1 / d dlambda
+          double eps_ps1 = 0;
+          if (degrading)
+            {
+              it.dlambda      = x[i_dl];
+              eps_ps1         = d.eps_ps0 + std::abs(it.dlambda);
+              it.eta1         = eta_of(c, eps_ps1);
+              const double sl = it.dlambda != 0 ? sign(it.dlambda) : d.s_lambda;
+              if (c.c_eta > 0)
+                deta = c.c_eta * std::pow(it.eta1, -c.m_u) * sl;
+              it.nu1 = 1.0 + c.c_nu_scaled * x[i_eh];
+              it.c   = it.nu1 * it.H2 * it.lambda1 * nDe / it.eta1;
+            }
+          else
+            {
+              it.c       = it.H2 * it.lambda1 * nDe;
+              it.dlambda = it.c * it.wn;
+              eps_ps1    = d.eps_ps0 + std::abs(it.dlambda);
+            }
+          const double dl = it.dlambda;
+          it.sigma_y1     = c.sigma_y0 + c.iso * eps_ps1;
+          it.q1           = qt - c.kin_q * dl;
+
+          for (unsigned int a = 0; a < K; ++a)
+            R[a] = sigma[a] - d.sigma0[a] - d.De[a] / it.eta1 + dl * it.Dn[a];
+          R[i_w]          = it.q1 / it.sigma_y1 - w;
+          const double sn = dot<K>(sigma, it.n_K.data());
+          if (degrading)
+            {
+              R[i_dl] = dl - it.c * it.wn;
+              R[i_eh] = x[i_eh] - d.e_h0 - dl * sn;
+            }
+
+          const double sl = dl != 0 ? sign(dl) : d.s_lambda;
+          // d R_w / d dlambda
+          it.gw = -c.kin_q / it.sigma_y1 - it.q1 * c.iso * sl / (it.sigma_y1 * it.sigma_y1);
+          if (!J)
+            return;
+
+          // dn_K / dsigma = 3/(2 q) (P_dev - 2/3 n n) restricted to K (symmetric).
+          MatK Nk;
+          for (unsigned int b = 0; b < K; ++b)
+            for (unsigned int a = 0; a < K; ++a)
+              {
+                const unsigned int fb = G::full[b], fa = G::full[a];
+                const double pdev = (fa == fb ? 1.0 : 0.0) - (fa < 3 && fb < 3 ? 1.0 / 3.0 : 0.0);
+                Nk[b][a]          = inv_q * (pdev - 2.0 / 3.0 * it.n[fb] * it.n[fa]);
+              }
+          MatK DN; // D Nk, column by column
+          for (unsigned int a = 0; a < K; ++a)
+            {
+              VecK col, dcol;
+              for (unsigned int b = 0; b < K; ++b)
+                col[b] = Nk[b][a];
+              apply_D(c, col.data(), dcol.data());
+              for (unsigned int b = 0; b < K; ++b)
+                DN[b][a] = dcol[b];
+            }
+          VecK dc_dsigma, Nsigma;
+          for (unsigned int a = 0; a < K; ++a)
+            {
+              double dnDn = 0, dnDe = 0, ns = 0;
+              for (unsigned int b = 0; b < K; ++b)
+                {
+                  dnDn += 2.0 * it.Dn[b] * Nk[b][a];
+                  dnDe += d.De[b] * Nk[b][a];
+                  ns += sigma[b] * Nk[b][a];
+                }
+              const double dlambda1 = -it.lambda1 * it.lambda1 * dnDn;
+              dc_dsigma[a] = it.nu1 * it.H2 / it.eta1 * (nDe * dlambda1 + it.lambda1 * dnDe);
+              Nsigma[a]    = ns;
+            }
+
+          MatM &Jm = *J;
+          Jm.fill(0.0);
+          const double dwn_dw = w > 0 ? c.n * it.wn / w : 0.0;
+          if (!degrading)
+            {
+              // dlambda = c(sigma) w^n eliminated.
+              const double ddl_dw = it.c * dwn_dw;
+              for (unsigned int a = 0; a < K; ++a)
+                {
+                  for (unsigned int b = 0; b < K; ++b)
+                    Jm[a * M + b] =
+                      (a == b ? 1.0 : 0.0) + dl * DN[a][b] + it.Dn[a] * it.wn * dc_dsigma[b];
+                  Jm[a * M + i_w] = it.Dn[a] * ddl_dw;
+                }
+              for (unsigned int b = 0; b < K; ++b)
+                Jm[i_w * M + b] = it.n_K[b] / it.sigma_y1 + it.gw * it.wn * dc_dsigma[b];
+              Jm[i_w * M + i_w] = -1.0 + it.gw * ddl_dw;
+            }
+          else
+            {
+              const double dc_ddl = -it.c * deta / it.eta1;
+              const double dc_deh = it.H2 * it.lambda1 * nDe * c.c_nu_scaled / it.eta1;
+              for (unsigned int a = 0; a < K; ++a)
+                {
+                  for (unsigned int b = 0; b < K; ++b)
+                    Jm[a * M + b] = (a == b ? 1.0 : 0.0) + dl * DN[a][b];
+                  Jm[a * M + i_dl] = it.Dn[a] + d.De[a] * deta / (it.eta1 * it.eta1);
+                }
+              for (unsigned int b = 0; b < K; ++b)
+                {
+                  Jm[i_w * M + b]  = it.n_K[b] / it.sigma_y1;
+                  Jm[i_dl * M + b] = -it.wn * dc_dsigma[b];
+                  Jm[i_eh * M + b] = -dl * (it.n_K[b] + Nsigma[b]);
+                }
+              Jm[i_w * M + i_w]   = -1.0;
+              Jm[i_w * M + i_dl]  = it.gw;
+              Jm[i_dl * M + i_w]  = -it.c * dwn_dw;
+              Jm[i_dl * M + i_dl] = 1.0 - it.wn * dc_ddl;
+              Jm[i_dl * M + i_eh] = -it.wn * dc_deh;
+              Jm[i_eh * M + i_dl] = -sn;
+              Jm[i_eh * M + i_eh] = 1.0;
+            }
+        }
+
+        /// Scale of unknown / residual i: sigma_y0 (stresses), 1 (w), eps_y (dlambda),
+        /// sigma_y0 eps_y (e_h). Newton solves the scaled system (unscaled, the
+        /// Jacobian entries span some 20 orders of magnitude).
+        static double
+        unknown_scale(const Constants &c, const unsigned int i)
+        {
+          return i < K ? c.sigma_y0 : i == i_w ? 1.0 : i == i_dl ? c.eps_y : c.sigma_y0 * c.eps_y;
+        }
+
+        static double
+        inverse_scale(const Constants &c, const unsigned int i)
+        {
+          return i < K ? c.inv_sigma_y0 : i == i_w ? 1.0 : i == i_dl ? c.inv_eps_y : c.inv_energy;
+        }
+
+        /// J -> S_R^-1 J S_x (the same scales for residuals and unknowns).
+        static void
+        scale_jacobian(const Constants &c, MatM &J)
+        {
+          for (unsigned int i = 0; i < M; ++i)
+            {
+              const double inv_i = inverse_scale(c, i);
+              for (unsigned int j = 0; j < M; ++j)
+                J[i * M + j] *= unknown_scale(c, j) * inv_i;
+            }
+        }
+
+        /// Sum of squares of the scaled residual (the merit function of the line search).
+        static double
+        residual_norm2(const Constants &c, const VecM &R)
+        {
+          double e = 0;
+          for (unsigned int i = 0; i < M; ++i)
+            e += (R[i] * inverse_scale(c, i)) * (R[i] * inverse_scale(c, i));
+          return e;
+        }
+
+        static double
+        residual_norm(const Constants &c, const VecM &R)
+        {
+          double e = 0;
+          for (unsigned int i = 0; i < M; ++i)
+            e = max_nan(e, std::abs(R[i]) * inverse_scale(c, i));
+          return e;
+        }
+
+        /**
+         * Backward Euler for 3D and plane strain without degradation while loading
+         * (n_tr : D : deps > 0): D n = 2 mu n for deviatoric n, so the end-state
+         * direction is the trial one (radial return), n1 = n_tr, and
+         *   sigma1 = sigma_tr - 2 mu dlambda n_tr,   q1 = q_tr - b dlambda,
+         *   b = 3 mu + (1 - m) H',   sigma_y1 = sigma_y + m H' dlambda,
+         *   dlambda = c w^n,   c = H2 n_tr : D : deps / (H' + 3 mu)  (constant).
+         * One scalar equation for w = q1 / sigma_y1:
+         *   g(w) = q_tr - b c w^n - w (sigma_y + m H' c w^n) = 0,
+         * concave and decreasing for n >= 1, so Newton from w0 = min(1, q_tr / sigma_y)
+         * (where g <= 0) converges monotonically. Consistent tangent:
+         *   T = D - 2 mu n_tr (x) d dlambda / d deps - 4 mu^2 dlambda N,
+         *   N = dn/dxi = 3/(2 q_tr) (P_dev - 2/3 n_tr (x) n_tr),
+         *   d dlambda = w^n dc + c n w^(n-1) dw,  dw = -(dq_tr + dg/dc dc) / (dg/dw),
+         *   dq_tr = 2 mu n_tr,  dc = H2 2 mu (n_tr + N D deps) / (H' + 3 mu).
+         */
+        static unsigned int
+        radial_return(const Constants &c,
+                      VecN            &y,
+                      const BEData    &d,
+                      const VecK      &sigma_tr,
+                      const double     q_tr,
+                      const VecK      &n_tr,
+                      const double     nDe_tr,
+                      const double     sigma_y,
+                      double          &H1,
+                      MatK            *T)
+        {
+          const double mu      = 0.5 * c.two_mu;
+          const double b       = 3.0 * mu + c.kin_q;
+          const double lambda1 = 1.0 / (c.H + 3.0 * mu);
+          const double cc      = d.H2 * lambda1 * nDe_tr;
+          double       w       = std::min(1.0, q_tr / sigma_y);
+          double       wn = power(c, w), g = 0, dg = -1;
+          unsigned int iterations = 0;
+          while (true)
+            {
+              g  = q_tr - b * cc * wn - w * (sigma_y + c.iso * cc * wn);
+              dg = -c.n * (b * cc + c.iso * cc * w) * wn / w - sigma_y - c.iso * cc * wn;
+              if (std::abs(g) * c.inv_sigma_y0 <= c.tol)
+                break;
+              if (iterations == c.max_iterations || !std::isfinite(g))
+                {
+                  std::ostringstream m;
+                  m << "Bouc-Wen (backward Euler): the radial-return Newton iteration did not "
+                       "converge in "
+                    << iterations << " iterations (scaled residual " << std::abs(g) / c.sigma_y0
+                    << ", tolerance " << c.tol << ", trial q/sigma_y = " << q_tr / sigma_y
+                    << "). Reduce the strain increment or raise Material/Bouc-Wen/Tolerance.";
+                  throw RuntimeError(m.str());
+                }
+              ++iterations;
+              const double w_new = w - g / dg;
+              w                  = w_new > 0 ? w_new : 0.5 * w; // safeguard (n < 1)
+              wn                 = power(c, w);
+            }
+          const double dl = cc * wn;
+          for (unsigned int a = 0; a < K; ++a)
+            y[a] = sigma_tr[a] - c.two_mu * dl * n_tr[a];
+          for (unsigned int f = 0; f < F; ++f)
+            y[i_epsp + f] += dl * n_tr[f];
+          y[i_eps_ps] += dl;
+          H1 = H1_of(c, std::max(q_tr - b * dl, 0.0), sigma_y + c.iso * dl);
+
+          if (T)
+            {
+              // N D deps = 3/(2 q) (dev(De) - 2/3 n (n : De)); N is symmetric.
+              VecK         NDe;
+              const double p = (d.De[0] + d.De[1] + d.De[2]) / 3.0;
+              for (unsigned int a = 0; a < K; ++a)
+                NDe[a] = 1.5 / q_tr * (d.De[a] - (a < 3 ? p : 0.0) - 2.0 / 3.0 * n_tr[a] * nDe_tr);
+              const double dg_dc = -b * wn - c.iso * w * wn;
+              VecK         ddl;
+              for (unsigned int a = 0; a < K; ++a)
+                {
+                  const double dc = d.H2 * lambda1 * c.two_mu * (n_tr[a] + NDe[a]);
+                  const double dw = -(c.two_mu * n_tr[a] + dg_dc * dc) / dg;
+                  ddl[a]          = wn * dc + cc * c.n * wn / w * dw;
+                }
+              const double f = 1.5 / q_tr * c.two_mu * c.two_mu * dl;
+              for (unsigned int a = 0; a < K; ++a)
+                for (unsigned int e = 0; e < K; ++e)
+                  {
+                    const double pdev = (a == e ? 1.0 : 0.0) - (a < 3 && e < 3 ? 1.0 / 3.0 : 0.0);
+                    (*T)[a][e]        = D_entry(c, a, e) - c.two_mu * n_tr[a] * ddl[e] -
+                                 f * (pdev - 2.0 / 3.0 * n_tr[a] * n_tr[e]);
+                  }
+            }
+          return iterations;
+        }
+
+        /// Trial-based initial guess: w0 = min(1, q_tr / sigma_y), dlambda0 = c_tr w0^n,
+        /// sigma0 + D deps / eta - dlambda0 D n_tr (n_tr at the trial state of d.De).
+        static void
+        guess(const Constants &c, const BEData &d, VecM &x)
+        {
+          const double eta0 = eta_of(c, d.eps_ps0);
+          VecK         sigma_tr, n_tr, Dn_tr;
+          for (unsigned int a = 0; a < K; ++a)
+            sigma_tr[a] = d.sigma0[a] + d.De[a] / eta0;
+          VecF         dev;
+          const double q_tr =
+            relative_deviator(sigma_tr.data(), kinematic ? d.alpha0.data() : nullptr, dev);
+          for (unsigned int a = 0; a < K; ++a)
+            n_tr[a] = q_tr > 0 ? 1.5 * dev[G::full[a]] / q_tr : 0.0;
+          apply_D(c, n_tr.data(), Dn_tr.data());
+          const double nDe  = dot<K>(n_tr.data(), d.De.data());
+          const double nu0  = degrading ? 1.0 + c.c_nu_scaled * d.e_h0 : 1.0;
+          const double H2   = c.beta + c.gamma * sign(nDe);
+          const double c_tr = nu0 * H2 * nDe / ((c.H + dot<K>(n_tr.data(), Dn_tr.data())) * eta0);
+          const double sigma_y = c.sigma_y0 + c.iso * d.eps_ps0;
+          const double w0      = std::max(std::min(1.0, q_tr / sigma_y), 1e-3);
+          const double dl0     = c_tr * power(c, w0);
+          const double eta1    = eta_of(c, d.eps_ps0 + std::abs(dl0));
+          for (unsigned int a = 0; a < K; ++a)
+            x[a] = d.sigma0[a] + d.De[a] / eta1 - dl0 * Dn_tr[a];
+          x[i_w] = w0;
+          if (degrading)
+            {
+              x[i_dl] = dl0;
+              x[i_eh] = d.e_h0 + dl0 * dot<K>(x.data(), n_tr.data());
+            }
+        }
+
+        /**
+         * Newton's method on the scaled system with backtracking (Armijo on the
+         * scaled 2-norm, for which the Newton step is a descent direction), keeping
+         * w > 0. On return @p R and @p it belong to @p x. Returns whether the scaled
+         * max-norm residual reached the tolerance within @p max_iterations (adds the
+         * iterations to @p iterations). The Jacobian is evaluated only where a step
+         * is taken.
+         */
+        static bool
+        newton(const Constants   &c,
+               const BEData      &d,
+               VecM              &x,
+               VecM              &R,
+               Iterate           &it,
+               const unsigned int max_iterations,
+               unsigned int      &iterations)
+        {
+          VecM                        R_new, x_new, dx;
+          MatM                        J;
+          std::array<unsigned int, M> pivot;
+          Iterate                     it_new;
+          evaluate(c, d, x, R, nullptr, it);
+          double norm = residual_norm(c, R);
+          for (unsigned int k = 0; !(norm <= c.tol); ++k)
+            {
+              if (k == max_iterations || !std::isfinite(norm))
+                return false;
+              ++iterations;
+              evaluate(c, d, x, R, &J, it);
+              scale_jacobian(c, J);
+              if (!lu_factorize<M>(J, pivot))
+                return false;
+              for (unsigned int i = 0; i < M; ++i)
+                dx[i] = -R[i] * inverse_scale(c, i);
+              lu_solve<M>(J, pivot, dx.data());
+              for (unsigned int i = 0; i < M; ++i)
+                dx[i] *= unknown_scale(c, i);
+              double t = 1.0;
+              if (x[i_w] + dx[i_w] <= 0)
+                t = 0.9 * x[i_w] / -dx[i_w];
+              else if (x[i_w] + dx[i_w] > d.w_cap)
+                t = std::max(0.0, (d.w_cap - x[i_w]) / dx[i_w]);
+              const double merit = residual_norm2(c, R);
+              for (unsigned int ls = 0; ls < 30; ++ls, t *= 0.5)
+                {
+                  for (unsigned int i = 0; i < M; ++i)
+                    x_new[i] = x[i] + t * dx[i];
+                  evaluate(c, d, x_new, R_new, nullptr, it_new);
+                  if (residual_norm2(c, R_new) <= (1.0 - 1e-4 * t) * merit)
+                    break;
+                }
+              x    = x_new;
+              R    = R_new;
+              it   = it_new;
+              norm = residual_norm(c, R);
+            }
+          return true;
+        }
+
+        /**
+         * Backward Euler over the increment deps: updates y (same layout as the
+         * explicit integrators), writes H1, H2 and, if @p T is given, the
+         * consistent tangent d sigma1 / d deps (Mandel). Returns the number of
+         * Newton iterations. Throws RuntimeError if Newton does not converge.
+         */
+        static unsigned int
+        backward_euler(const Constants &c,
+                       VecN            &y,
+                       const VecK      &deps,
+                       double          &H1,
+                       double          &H2,
+                       MatK            *T)
+        {
+          BEData d;
+          for (unsigned int a = 0; a < K; ++a)
+            d.sigma0[a] = y[a];
+          apply_D(c, deps.data(), d.De.data());
+          if (kinematic)
+            for (unsigned int f = 0; f < F; ++f)
+              d.alpha0[f] = c.kin * y[i_epsp + f];
+          d.eps_ps0 = y[i_eps_ps];
+          d.e_h0    = degrading ? y[i_e_h] : 0.0;
+
+          // Elastic trial state and the loading direction.
+          const double eta0 = eta_of(c, d.eps_ps0);
+          VecK         sigma_tr;
+          for (unsigned int a = 0; a < K; ++a)
+            sigma_tr[a] = d.sigma0[a] + d.De[a] / eta0;
+          VecF         dev;
+          const double q_tr =
+            relative_deviator(sigma_tr.data(), kinematic ? d.alpha0.data() : nullptr, dev);
+          VecK n_tr, Dn_tr;
+          for (unsigned int a = 0; a < K; ++a)
+            n_tr[a] = q_tr > 0 ? 1.5 * dev[G::full[a]] / q_tr : 0.0;
+          apply_D(c, n_tr.data(), Dn_tr.data());
+          const double nDe_tr   = dot<K>(n_tr.data(), d.De.data());
+          const double sigma_y0 = c.sigma_y0 + c.iso * d.eps_ps0;
+          d.H2                  = c.beta + c.gamma * sign(nDe_tr);
+          d.s_lambda            = sign(nDe_tr);
+          H2                    = d.H2;
+          {
+            VecF         dev0;
+            const double q0 =
+              relative_deviator(d.sigma0.data(), kinematic ? d.alpha0.data() : nullptr, dev0);
+            d.w_cap = 2.0 * std::max(1.0, std::max(q_tr, q0) / sigma_y0);
+            // With beta > gamma, nu_s H1 (beta - gamma) > 1 is the run-away regime of the
+            // law itself (Phi' = n:D:deps (1 - nu_s H1 H2) > 0 while unloading): keep
+            // the iterates below it.
+            const double nu0 = degrading ? 1.0 + c.c_nu_scaled * d.e_h0 : 1.0;
+            if (c.beta > c.gamma && nu0 > 0)
+              d.w_cap = std::min(d.w_cap, std::pow(nu0 * (c.beta - c.gamma), -1.0 / c.n));
+          }
+
+          if (q_tr == 0 || d.H2 == 0 || nDe_tr == 0)
+            {
+              // Exactly elastic: lambda' = 0 (H1 = 0, or H2 = 0, or n:D:deps = 0).
+              for (unsigned int a = 0; a < K; ++a)
+                y[a] = sigma_tr[a];
+              if (track_eps_zz)
+                y[i_eps_zz] += eta0 * (-c.nu / c.E * (y[0] - d.sigma0[0] + y[1] - d.sigma0[1]));
+              H1 = H1_of(c, q_tr, sigma_y0);
+              if (T)
+                for (unsigned int a = 0; a < K; ++a)
+                  for (unsigned int b = 0; b < K; ++b)
+                    (*T)[a][b] = D_entry(c, a, b) / eta0;
+              return 0;
+            }
+
+          if constexpr (S != StressState::plane_stress && !degrading)
+            if (nDe_tr > 0)
+              return radial_return(c, y, d, sigma_tr, q_tr, n_tr, nDe_tr, sigma_y0, H1, T);
+
+          // Newton from the trial-based guess for the whole increment; if it fails,
+          // continuation in the increment: solve the backward Euler problem for
+          // s deps, s = ds, 2 ds, ... -> 1, each from the previous solution. The result
+          // is the backward Euler solution of the whole increment in either case.
+          VecM                        x;
+          Iterate                     it;
+          VecM                        R;
+          const VecK                  De         = d.De;
+          unsigned int                iterations = 0;
+          std::array<unsigned int, M> pivot;
+          MatM                        J;
+          guess(c, d, x);
+          if (!newton(c, d, x, R, it, c.max_iterations, iterations))
+            {
+              VecM   x_done = x;
+              bool   have   = false;
+              double s_done = 0, ds = 0.25;
+              while (s_done < 1)
+                {
+                  if (ds < 1e-6 || iterations > 20 * c.max_iterations)
+                    {
+                      std::ostringstream m;
+                      m << "Bouc-Wen (backward Euler): the local Newton iteration did not "
+                           "converge (tolerance "
+                        << c.tol << ", trial q/sigma_y = " << q_tr / sigma_y0
+                        << ", continuation stalled at " << s_done << " of the increment after "
+                        << iterations
+                        << " iterations). Reduce the strain increment or raise "
+                           "Material/Bouc-Wen/Tolerance.";
+                      throw RuntimeError(m.str());
+                    }
+                  const double s_try = std::min(1.0, s_done + ds);
+                  for (unsigned int a = 0; a < K; ++a)
+                    d.De[a] = s_try * De[a];
+                  if (have)
+                    x = x_done;
+                  else
+                    guess(c, d, x);
+                  if (newton(c, d, x, R, it, c.max_iterations, iterations))
+                    {
+                      s_done = s_try;
+                      x_done = x;
+                      have   = true;
+                      ds *= 2;
+                    }
+                  else
+                    ds *= 0.25;
+                }
+              x = x_done;
+              evaluate(c, d, x, R, nullptr, it);
+            }
+
+          // The converged end state.
+          const double dl = it.dlambda;
+          for (unsigned int a = 0; a < K; ++a)
+            y[a] = x[a];
+          for (unsigned int f = 0; f < F; ++f)
+            y[i_epsp + f] += dl * it.n[f];
+          y[i_eps_ps] += std::abs(dl);
+          if (degrading)
+            y[i_e_h] = x[i_eh];
+          if (track_eps_zz)
+            y[i_eps_zz] +=
+              it.eta1 * (-c.nu / c.E * (y[0] - d.sigma0[0] + y[1] - d.sigma0[1]) + dl * it.n[2]);
+          H1 = H1_of(c, std::max(it.q1, 0.0), it.sigma_y1);
+          H2 = it.H2;
+
+          if (T)
+            {
+              // Implicit function theorem: d x / d deps = -J^-1 dR/d deps (scaled).
+              evaluate(c, d, x, R, &J, it);
+              scale_jacobian(c, J);
+              if (!lu_factorize<M>(J, pivot))
+                throw RuntimeError("Bouc-Wen (backward Euler): singular local Jacobian");
+              VecK dc_de; // d c / d deps = nu1 H2 lambda1 D n / eta1
+              for (unsigned int b = 0; b < K; ++b)
+                dc_de[b] = it.nu1 * it.H2 * it.lambda1 * it.Dn[b] / it.eta1;
+              for (unsigned int b = 0; b < K; ++b)
+                {
+                  VecM col{};
+                  for (unsigned int a = 0; a < K; ++a)
+                    col[a] = -D_entry(c, a, b) / it.eta1;
+                  if (!degrading)
+                    {
+                      const double ddl = it.wn * dc_de[b];
+                      for (unsigned int a = 0; a < K; ++a)
+                        col[a] += it.Dn[a] * ddl;
+                      col[i_w] = it.gw * ddl;
+                    }
+                  else
+                    col[i_dl] = -it.wn * dc_de[b];
+                  for (unsigned int i = 0; i < M; ++i)
+                    col[i] = -col[i] * inverse_scale(c, i);
+                  lu_solve<M>(J, pivot, col.data());
+                  for (unsigned int a = 0; a < K; ++a)
+                    (*T)[a][b] = col[a] * c.sigma_y0;
+                }
+            }
+          return iterations;
+        }
+      };
+    } // namespace BoucWenKernels
+  }   // namespace Material
+} // namespace hysteron
+
+#endif

@@ -1,0 +1,644 @@
+// Unit tests of the uniaxial Bouc-Wen law (hysteron::Material::BoucWenUniaxial):
+// closed forms, convergence of the three integrators, algorithmic tangent,
+// saturation bound, degradation (Table 2-2) and the energy balance.
+#include <hysteron/base/exceptions.h>
+#include <hysteron/material/bouc_wen_uniaxial.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iostream>
+#include <limits>
+#include <vector>
+
+namespace
+{
+  using hysteron::Material::BoucWenIntegrator;
+  using hysteron::Material::BoucWenParameters;
+  using hysteron::Material::BoucWenUniaxial;
+
+  constexpr double E       = 200e9;
+  constexpr double sigma_y = 200e6;
+  constexpr double z_y     = sigma_y / E; // 1e-3
+
+  const std::array<BoucWenIntegrator, 3> all_integrators{{BoucWenIntegrator::forward_euler,
+                                                          BoucWenIntegrator::adaptive,
+                                                          BoucWenIntegrator::backward_euler}};
+
+  const char *
+  name(const BoucWenIntegrator integrator)
+  {
+    return integrator == BoucWenIntegrator::forward_euler ? "forward euler" :
+           integrator == BoucWenIntegrator::adaptive      ? "adaptive" :
+                                                            "backward euler";
+  }
+
+  BoucWenParameters
+  parameters(const double            n,
+             const BoucWenIntegrator integrator,
+             const double            tolerance = 1e-6,
+             const double            a         = 0.0)
+  {
+    BoucWenParameters p;
+    p.yield_stress     = sigma_y;
+    p.post_yield_ratio = a;
+    p.smoothness       = n;
+    p.beta             = 0.5;
+    p.gamma            = 0.5;
+    p.integrator       = integrator;
+    p.tolerance        = tolerance;
+    return p;
+  }
+
+  /// The response along a strain path eps[0] = 0, eps[1], ...
+  struct Response
+  {
+    std::vector<double>                eps, sig;
+    std::vector<std::array<double, 3>> state;
+    unsigned long                      work = 0;
+  };
+
+  Response
+  drive(const BoucWenUniaxial &law, const std::vector<double> &eps)
+  {
+    Response              r;
+    std::array<double, 3> s{{0, 1, 0}};
+    law.initialize_state(s.data());
+    double sigma = law.stress(eps[0], s.data());
+    r.eps.push_back(eps[0]);
+    r.sig.push_back(sigma);
+    r.state.push_back(s);
+    for (std::size_t i = 1; i < eps.size(); ++i)
+      {
+        r.work += law.update(eps[i] - eps[i - 1], sigma, s.data());
+        r.eps.push_back(eps[i]);
+        r.sig.push_back(sigma);
+        r.state.push_back(s);
+      }
+    return r;
+  }
+
+  /// 0, dx, 2 dx, ..., x_max (in units of z_y).
+  std::vector<double>
+  monotonic_path(const double dx, const double x_max)
+  {
+    const unsigned int  n = std::lround(x_max / dx);
+    std::vector<double> eps(n + 1);
+    for (unsigned int i = 0; i <= n; ++i)
+      eps[i] = i * dx * z_y;
+    return eps;
+  }
+
+  /// max_i |z_i/z_y - u(x_i)| along a monotonic path, u the closed form.
+  template <typename Exact>
+  double
+  closed_form_error(const BoucWenUniaxial &law, const double dx, const double x_max, Exact exact)
+  {
+    const Response r   = drive(law, monotonic_path(dx, x_max));
+    double         err = 0;
+    for (std::size_t i = 0; i < r.eps.size(); ++i)
+      err = std::max(err, std::abs(r.state[i][0] / z_y - exact(r.eps[i] / z_y)));
+    return err;
+  }
+
+  const auto exact_n1 = [](const double x) {
+    return 1 - std::exp(-x);
+  };
+  const auto exact_n2 = [](const double x) {
+    return std::tanh(x);
+  };
+} // namespace
+
+
+
+TEST(BoucWenUniaxial, StateLayout)
+{
+  BoucWenParameters p = parameters(2, BoucWenIntegrator::adaptive);
+  BoucWenUniaxial   plain(p, E);
+  EXPECT_FALSE(plain.degradation());
+  EXPECT_EQ(plain.n_state_variables(), 1u);
+  EXPECT_EQ(plain.state_variable_names(), std::vector<std::string>({"z"}));
+  EXPECT_DOUBLE_EQ(plain.yield_deformation(), z_y);
+
+  p.stiffness_degradation_c_eta = 1;
+  BoucWenUniaxial degrading(p, E);
+  EXPECT_TRUE(degrading.degradation());
+  EXPECT_EQ(degrading.n_state_variables(), 3u);
+  EXPECT_EQ(degrading.state_variable_names(), std::vector<std::string>({"z", "eta", "e_h"}));
+  double s[3] = {7, 7, 7};
+  degrading.initialize_state(s);
+  EXPECT_EQ(s[0], 0);
+  EXPECT_EQ(s[1], 1);
+  EXPECT_EQ(s[2], 0);
+
+  // A spring: stiffness 1e6 N/m, yield force 2e3 N -> z_y = 2 mm.
+  BoucWenUniaxial spring(p, 1e6, 2e3);
+  EXPECT_DOUBLE_EQ(spring.yield_deformation(), 2e-3);
+}
+
+
+
+// n = 1, beta + gamma = 1: dz/deps = 1 - z/z_y, so z/z_y = 1 - exp(-x).
+TEST(BoucWenUniaxial, MonotonicClosedFormN1)
+{
+  for (const auto integrator : all_integrators)
+    {
+      const bool   adaptive = integrator == BoucWenIntegrator::adaptive;
+      const double dx       = adaptive ? 0.05 : 0.001;
+      const double err =
+        closed_form_error(BoucWenUniaxial(parameters(1, integrator, 1e-9), E), dx, 6, exact_n1);
+      std::cout << "  n = 1, " << name(integrator) << ", dx = " << dx << " eps_y: max error " << err
+                << " z_y" << std::endl;
+      EXPECT_LT(err, adaptive ? 5e-9 : 2.5e-4) << name(integrator);
+    }
+}
+
+
+
+// n = 2, beta + gamma = 1: dz/deps = 1 - (z/z_y)^2, so z/z_y = tanh(x).
+TEST(BoucWenUniaxial, MonotonicClosedFormN2Tanh)
+{
+  for (const auto integrator : all_integrators)
+    {
+      const bool      adaptive = integrator == BoucWenIntegrator::adaptive;
+      const double    dx       = adaptive ? 0.05 : 0.001;
+      BoucWenUniaxial law(parameters(2, integrator, 1e-9, 0.05), E);
+      const double    err = closed_form_error(law, dx, 6, exact_n2);
+      std::cout << "  n = 2, " << name(integrator) << ", dx = " << dx << " eps_y: max error " << err
+                << " z_y" << std::endl;
+      EXPECT_LT(err, adaptive ? 5e-9 : 2.5e-4) << name(integrator);
+
+      // and the stress is a E eps + (1 - a) E z
+      const Response r = drive(law, monotonic_path(dx, 6));
+      for (std::size_t i = 0; i < r.eps.size(); ++i)
+        ASSERT_NEAR(r.sig[i], 0.05 * E * r.eps[i] + 0.95 * E * r.state[i][0], 1e-12 * sigma_y);
+    }
+}
+
+
+
+// Far beyond yield the stress lies on the hardening line a E eps + (1 - a) sigma_y.
+TEST(BoucWenUniaxial, SaturationStress)
+{
+  for (const double n : {1.0, 2.0, 8.0, 16.0})
+    for (const auto integrator : all_integrators)
+      {
+        const double    a = 0.05;
+        BoucWenUniaxial law(parameters(n, integrator, 1e-10, a), E);
+        const Response  r   = drive(law, monotonic_path(0.01, 40));
+        const double    eps = r.eps.back();
+        EXPECT_NEAR(r.sig.back(), a * E * eps + (1 - a) * sigma_y, 1e-9 * sigma_y)
+          << "n = " << n << ", " << name(integrator);
+      }
+}
+
+
+
+// beta = gamma = 1/2: H2 = 0 when sgn(z deps) < 0, so unloading is exactly
+// elastic, with the degraded stiffness (a + (1 - a) / eta) E, and neither eta
+// nor e_h changes.
+TEST(BoucWenUniaxial, ElasticUnloadingForBetaEqualsGamma)
+{
+  for (const bool degrading : {false, true})
+    for (const auto integrator : all_integrators)
+      {
+        BoucWenParameters p = parameters(8, integrator, 1e-8, 0.05);
+        if (degrading)
+          {
+            p.stiffness_degradation_c_eta = 30;
+            p.strength_deterioration_c_nu = 0.01;
+          }
+        BoucWenUniaxial       law(p, E);
+        std::array<double, 3> s{{0, 1, 0}};
+        law.initialize_state(s.data());
+        double sigma = 0;
+        for (unsigned int i = 0; i < 400; ++i)
+          law.update(0.01 * z_y, sigma, s.data());
+        ASSERT_GT(s[0], 0.9 * z_y);
+        const double eta = degrading ? s[1] : 1.0;
+        const double e_h = s[2];
+
+        unsigned int n_unloading = 0;
+        while (s[0] > 0.1 * z_y)
+          {
+            const double before = sigma;
+            law.update(-0.05 * z_y, sigma, s.data());
+            const double expected = -(0.05 + 0.95 / eta) * E * 0.05 * z_y;
+            ASSERT_NEAR(sigma - before, expected, 1e-12 * std::abs(expected))
+              << name(integrator) << (degrading ? ", degrading" : "");
+            if (degrading)
+              {
+                ASSERT_EQ(s[1], eta);
+                ASSERT_EQ(s[2], e_h);
+              }
+            ++n_unloading;
+          }
+        EXPECT_GT(n_unloading, 10u);
+      }
+}
+
+
+
+// Large n approaches the bilinear (elastic - linear hardening) law.
+TEST(BoucWenUniaxial, LargeNApproachesBilinear)
+{
+  const double a         = 0.05;
+  const auto   deviation = [&](const double n) {
+    BoucWenUniaxial law(parameters(n, BoucWenIntegrator::adaptive, 1e-10, a), E);
+    const Response  r = drive(law, monotonic_path(0.001, 3));
+    double          d = 0;
+    for (std::size_t i = 0; i < r.eps.size(); ++i)
+      {
+        const double eps      = r.eps[i];
+        const double bilinear = eps <= z_y ? E * eps : a * E * eps + (1 - a) * sigma_y;
+        d                     = std::max(d, std::abs(r.sig[i] - bilinear) / sigma_y);
+      }
+    return d;
+  };
+  const double d16 = deviation(16), d200 = deviation(200);
+  std::cout << "  max |sigma - bilinear| / sigma_y: n = 16: " << d16 << ", n = 200: " << d200
+            << std::endl;
+  // At eps = eps_y: dz/deps = 1 - u^n gives 1 - u ~ ln(2)/n roughly.
+  EXPECT_LT(d200, 0.005);
+  EXPECT_LT(d200, d16 / 8);
+}
+
+
+
+// The Euler schemes are first order: halving the increment halves the error.
+TEST(BoucWenUniaxial, EulerSchemesAreFirstOrder)
+{
+  for (const auto integrator :
+       {BoucWenIntegrator::forward_euler, BoucWenIntegrator::backward_euler})
+    {
+      BoucWenUniaxial law(parameters(2, integrator, 1e-12), E);
+      double          previous = 0;
+      for (const double dx : {0.04, 0.02, 0.01, 0.005})
+        {
+          const double err = closed_form_error(law, dx, 3, exact_n2);
+          if (previous > 0)
+            {
+              std::cout << "  " << name(integrator) << ": dx = " << dx << ", error " << err
+                        << ", ratio " << previous / err << std::endl;
+              EXPECT_NEAR(previous / err, 2.0, 0.1) << name(integrator);
+            }
+          previous = err;
+        }
+    }
+}
+
+
+
+// The adaptive integrator meets its tolerance (per sub-step; over a whole
+// monotonic path of 50 increments the error stays within a few tolerances)
+// and converges to the closed form as the tolerance falls.
+TEST(BoucWenUniaxial, AdaptiveMeetsTolerance)
+{
+  double previous = 1;
+  for (const double tolerance : {1e-4, 1e-6, 1e-8, 1e-10})
+    for (const double dx : {0.1, 1.0})
+      {
+        const double err =
+          closed_form_error(BoucWenUniaxial(parameters(2, BoucWenIntegrator::adaptive, tolerance),
+                                            E),
+                            dx,
+                            5,
+                            exact_n2);
+        std::cout << "  adaptive: tolerance " << tolerance << ", dx = " << dx
+                  << ": error / tolerance = " << err / tolerance << std::endl;
+        EXPECT_LT(err, 5 * tolerance);
+        if (dx == 0.1)
+          {
+            EXPECT_LT(err, previous);
+            previous = err;
+          }
+      }
+}
+
+
+
+// The consistent tangent of backward Euler agrees with central differences of
+// the update, d sigma_{n+1} / d deps, in the elastic range, the transition,
+// saturation, unloading (beta > gamma: not elastic), across z = 0, and with
+// degradation.
+TEST(BoucWenUniaxial, BackwardEulerTangentMatchesFiniteDifferences)
+{
+  struct Case
+  {
+    double n, beta, gamma, c_eta, c_nu, m_u;
+  };
+  const std::vector<Case> cases = {{2, 0.5, 0.5, 0, 0, 1},
+                                   {8, 0.5, 0.5, 0, 0, 1},
+                                   {1.5, 0.75, 0.25, 0, 0, 1},
+                                   {16, 0.5, 0.5, 30, 0.001, 1},
+                                   {3, 0.75, 0.25, 5, 0.05, 1},
+                                   {4, 0.6, 0.4, 5, 0.05, 0.5}};
+  // (z_n / z_y, deps / z_y): inside, transition, near saturation, unloading,
+  // a large increment, crossing z = 0.
+  const std::vector<std::array<double, 2>> points =
+    {{{0.1, 0.05}}, {{0.6, 0.2}}, {{0.95, 0.5}}, {{0.9, -0.3}}, {{0.2, 3.0}}, {{0.3, -0.8}}};
+
+  double worst = 0;
+  for (const auto &c : cases)
+    for (const auto &point : points)
+      {
+        BoucWenParameters p = parameters(c.n, BoucWenIntegrator::backward_euler, 1e-13, 0.03);
+        p.beta              = c.beta;
+        p.gamma             = c.gamma;
+        p.stiffness_degradation_c_eta = c.c_eta;
+        p.strength_deterioration_c_nu = c.c_nu;
+        p.stiffness_degradation_m_u   = c.m_u;
+        BoucWenUniaxial       law(p, E);
+        std::array<double, 3> s0{{point[0] * z_y, 1.3, 2e4}};
+        const double          deps = point[1] * z_y;
+
+        const auto stress_after = [&](const double d, double *tangent) {
+          std::array<double, 3> s     = s0;
+          double                sigma = 0;
+          law.update(d, sigma, s.data(), tangent);
+          return sigma;
+        };
+        double       tangent = 0;
+        const double h       = 1e-6 * std::abs(deps);
+        stress_after(deps, &tangent);
+        const double fd =
+          (stress_after(deps + h, nullptr) - stress_after(deps - h, nullptr)) / (2 * h);
+        const double rel = std::abs(tangent - fd) / std::abs(fd);
+        worst            = std::max(worst, rel);
+        EXPECT_LT(rel, 1e-6) << "n = " << c.n << ", beta = " << c.beta << ", c_eta = " << c.c_eta
+                             << ", z_n/z_y = " << point[0] << ", deps/z_y = " << point[1]
+                             << ": tangent " << tangent << ", finite difference " << fd;
+      }
+  std::cout << "  worst relative difference tangent vs central differences: " << worst << std::endl;
+}
+
+
+
+// Forward Euler returns the exact derivative of its own (explicit) update;
+// the adaptive integrator the derivative of the exact flow, (a + (1 - a)(1 - u^2)) E
+// for n = 2 on the monotonic path.
+TEST(BoucWenUniaxial, ExplicitTangents)
+{
+  {
+    BoucWenUniaxial       law(parameters(8, BoucWenIntegrator::forward_euler, 1e-6, 0.03), E);
+    std::array<double, 3> s0{{0.7 * z_y, 1, 0}};
+    const double          deps = 0.1 * z_y, h = 1e-7 * z_y;
+    double                tangent = 0, sp = 0, sm = 0, s = 0;
+    std::array<double, 3> x = s0;
+    law.update(deps, s, x.data(), &tangent);
+    x = s0;
+    law.update(deps + h, sp, x.data());
+    x = s0;
+    law.update(deps - h, sm, x.data());
+    EXPECT_NEAR(tangent, (sp - sm) / (2 * h), 1e-7 * E);
+  }
+  {
+    const double          a = 0.05;
+    BoucWenUniaxial       law(parameters(2, BoucWenIntegrator::adaptive, 1e-10, a), E);
+    std::array<double, 3> s{{0, 1, 0}};
+    double                sigma = 0, eps = 0, tangent = 0;
+    for (unsigned int i = 0; i < 30; ++i)
+      {
+        law.update(0.1 * z_y, sigma, s.data(), &tangent);
+        eps += 0.1 * z_y;
+        const double u = std::tanh(eps / z_y);
+        ASSERT_NEAR(tangent, E * (a + (1 - a) * (1 - u * u)), 1e-8 * E);
+      }
+  }
+}
+
+
+
+// |z/z_y| never exceeds 1 (+ tolerance) for the adaptive and the backward
+// Euler integrator, even for n = 200 and increments of 7 eps_y on a cyclic path
+// of amplitude 20 eps_y. (Forward Euler is only stable for deps/eps_y <~ 2/n.)
+TEST(BoucWenUniaxial, SaturationIsNeverExceeded)
+{
+  for (const double n : {1.0, 2.0, 8.0, 16.0, 100.0, 200.0})
+    for (const double dx : {0.5, 3.0, 7.0})
+      for (const auto integrator : {BoucWenIntegrator::adaptive, BoucWenIntegrator::backward_euler})
+        {
+          const double        tolerance = 1e-6;
+          std::vector<double> eps{0};
+          for (const double target : {20.0, -20.0, 20.0, -20.0, 0.0})
+            while (std::abs(eps.back() / z_y - target) > 1e-9)
+              {
+                const double x = eps.back() / z_y;
+                eps.push_back((x + std::copysign(std::min(dx, std::abs(target - x)), target - x)) *
+                              z_y);
+              }
+          const Response r = drive(BoucWenUniaxial(parameters(n, integrator, tolerance), E), eps);
+          double         z_max = 0;
+          for (const auto &s : r.state)
+            z_max = std::max(z_max, std::abs(s[0]) / z_y);
+          EXPECT_LE(z_max, 1 + tolerance)
+            << "n = " << n << ", dx = " << dx << ", " << name(integrator);
+          EXPECT_GT(z_max, 0.99) << "n = " << n << ", dx = " << dx << ", " << name(integrator);
+        }
+}
+
+
+
+// Table 2-2 (E = 210 GPa, sigma_y = 235 MPa, a = 0.03, n = 16, beta = gamma = 0.5,
+// c_eta = 30, m_u = 1, c_nu = 0.001), three cycles eps = 0.006 sin(2 pi t / 12)
+// over 36 s: the peak stress falls every cycle, eta grows and is constant
+// during unloading; the end values agree with a converged reference
+// (adaptive, tolerance 1e-10, 36000 steps: eta = 1.992558, nu_s = 1.042797).
+TEST(BoucWenUniaxial, DegradationTable22)
+{
+  for (const auto integrator : all_integrators)
+    {
+      BoucWenParameters p;
+      p.yield_stress                = 235e6;
+      p.post_yield_ratio            = 0.03;
+      p.smoothness                  = 16;
+      p.beta                        = 0.5;
+      p.gamma                       = 0.5;
+      p.stiffness_degradation_c_eta = 30;
+      p.stiffness_degradation_m_u   = 1;
+      p.strength_deterioration_c_nu = 0.001;
+      p.integrator                  = integrator;
+      p.tolerance                   = 1e-8;
+      BoucWenUniaxial law(p, 210e9);
+      ASSERT_TRUE(law.degradation());
+
+      const unsigned int  n_steps = integrator == BoucWenIntegrator::adaptive ? 3600 : 36000;
+      std::vector<double> eps(n_steps + 1);
+      for (unsigned int i = 0; i <= n_steps; ++i)
+        eps[i] = 0.006 * std::sin(2 * M_PI * (36.0 * i / n_steps) / 12);
+      const Response r = drive(law, eps);
+
+      std::array<double, 3> peak{{-1e300, -1e300, -1e300}}, valley{{1e300, 1e300, 1e300}};
+      unsigned int          n_unloading = 0;
+      for (unsigned int i = 1; i <= n_steps; ++i)
+        {
+          const unsigned int cycle = std::min(2u, (3 * (i - 1)) / n_steps);
+          peak[cycle]              = std::max(peak[cycle], r.sig[i]);
+          valley[cycle]            = std::min(valley[cycle], r.sig[i]);
+          ASSERT_GE(r.state[i][1], r.state[i - 1][1]) << "eta decreases at step " << i;
+          if (r.state[i][0] * (eps[i] - eps[i - 1]) < 0) // unloading: H2 = 0
+            {
+              ASSERT_EQ(r.state[i][1], r.state[i - 1][1]) << "eta changes on unloading, step " << i;
+              ++n_unloading;
+            }
+        }
+      EXPECT_GT(n_unloading, n_steps / 10);
+      EXPECT_GT(peak[0], peak[1]);
+      EXPECT_GT(peak[1], peak[2]);
+      EXPECT_LT(valley[0], valley[1]);
+      EXPECT_LT(valley[1], valley[2]);
+
+      const auto  &end = r.state.back();
+      const double nu  = law.nu_s(end.data());
+      std::cout << "  Table 2-2, " << name(integrator) << ", " << n_steps
+                << " steps: eta = " << end[1] << ", e_h = " << end[2] << " J/m^3, nu_s = " << nu
+                << ", peaks " << peak[0] / 1e6 << " " << peak[1] / 1e6 << " " << peak[2] / 1e6
+                << " MPa" << std::endl;
+      EXPECT_NEAR(end[1], 1.992558, integrator == BoucWenIntegrator::adaptive ? 1e-5 : 2e-4);
+      EXPECT_NEAR(nu, 1.042797, 1e-5);
+    }
+}
+
+
+
+// Without degradation the energy dissipated over a closed cycle equals the
+// loop area: oint (1 - a) k z (deps - dz) = oint sigma deps (oint z dz = 0 and
+// oint eps deps = 0). The kernel with degrading = true and zero constants
+// book-keeps e_h while eta = nu_s = 1.
+TEST(BoucWenUniaxial, DissipatedEnergyEqualsLoopArea)
+{
+  for (const double beta : {0.5, 0.75})
+    for (const double n : {2.0, 8.0})
+      for (const auto integrator : all_integrators)
+        {
+          BoucWenParameters p = parameters(n, integrator, 1e-10, 0.05);
+          p.beta              = beta;
+          p.gamma             = 1 - beta;
+          const BoucWenUniaxial law(p, E);
+
+          const unsigned int    per_cycle = 20000;
+          std::array<double, 3> s{{0, 1, 0}};
+          double                sigma = 0, eps = 0;
+          std::vector<double>   e_cycle, s_cycle;
+          double                e_h_start = 0;
+          for (unsigned int i = 1; i <= 2 * per_cycle; ++i)
+            {
+              const double next = 5 * z_y * std::sin(2 * M_PI * i / per_cycle);
+              const double deps = next - eps;
+              switch (integrator)
+                {
+                  case BoucWenIntegrator::forward_euler:
+                    law.update_point<true, BoucWenIntegrator::forward_euler>(deps,
+                                                                             sigma,
+                                                                             s.data(),
+                                                                             nullptr);
+                    break;
+                  case BoucWenIntegrator::adaptive:
+                    law.update_point<true, BoucWenIntegrator::adaptive>(deps,
+                                                                        sigma,
+                                                                        s.data(),
+                                                                        nullptr);
+                    break;
+                  default:
+                    law.update_point<true, BoucWenIntegrator::backward_euler>(deps,
+                                                                              sigma,
+                                                                              s.data(),
+                                                                              nullptr);
+                }
+              ASSERT_EQ(s[1], 1.0);
+              eps = next;
+              if (i == per_cycle)
+                e_h_start = s[2];
+              if (i >= per_cycle)
+                {
+                  e_cycle.push_back(eps);
+                  s_cycle.push_back(sigma);
+                }
+            }
+          double area = 0; // shoelace formula of the closed polygon (eps, sigma)
+          for (std::size_t i = 0; i < e_cycle.size(); ++i)
+            {
+              const std::size_t j = (i + 1) % e_cycle.size();
+              area += 0.5 * (e_cycle[i] * s_cycle[j] - e_cycle[j] * s_cycle[i]);
+            }
+          area             = std::abs(area);
+          const double rel = std::abs(s[2] - e_h_start - area) / area;
+          std::cout << "  beta = " << beta << ", n = " << n << ", " << name(integrator)
+                    << ": loop area " << area << " J/m^3, relative difference of e_h " << rel
+                    << std::endl;
+          EXPECT_LT(rel, 1e-4);
+        }
+}
+
+
+
+// The batch update gives exactly the point updates.
+TEST(BoucWenUniaxial, BatchMatchesPointUpdates)
+{
+  for (const auto integrator : all_integrators)
+    for (const bool degrading : {false, true})
+      {
+        BoucWenParameters p = parameters(4, integrator, 1e-8, 0.02);
+        if (degrading)
+          p.stiffness_degradation_c_eta = 10;
+        BoucWenUniaxial     law(p, E);
+        const unsigned int  n = 7, m = law.n_state_variables();
+        std::vector<double> deps(n), sig(n, 0), sig2(n, 0), states(n * m), states2(n * m),
+          tangents(n), tangents2(n);
+        for (unsigned int i = 0; i < n; ++i)
+          {
+            deps[i] = (0.3 * i - 0.8) * z_y;
+            law.initialize_state(&states[i * m]);
+          }
+        states2 = states;
+        for (unsigned int step = 0; step < 5; ++step)
+          {
+            law.update(n, deps.data(), sig.data(), states.data(), tangents.data());
+            for (unsigned int i = 0; i < n; ++i)
+              law.update(deps[i], sig2[i], &states2[i * m], &tangents2[i]);
+          }
+        EXPECT_EQ(sig, sig2);
+        EXPECT_EQ(states, states2);
+        EXPECT_EQ(tangents, tangents2);
+      }
+}
+
+
+
+// n = 2 by repeated squaring and n = 2 (1 + 2^-52) by pow() agree.
+TEST(BoucWenUniaxial, IntegerAndRealExponentsAgree)
+{
+  const double    n_real = std::nextafter(2.0, 3.0);
+  BoucWenUniaxial integer_law(parameters(2, BoucWenIntegrator::backward_euler, 1e-12), E);
+  BoucWenUniaxial real_law(parameters(n_real, BoucWenIntegrator::backward_euler, 1e-12), E);
+  const auto      path = monotonic_path(0.1, 4);
+  const Response  r1 = drive(integer_law, path), r2 = drive(real_law, path);
+  for (std::size_t i = 0; i < path.size(); ++i)
+    EXPECT_NEAR(r1.state[i][0], r2.state[i][0], 1e-12 * z_y);
+}
+
+
+
+// A non-finite increment, an adaptive integration that needs too many
+// sub-steps: RuntimeError, never a silent NaN.
+TEST(BoucWenUniaxial, FailuresAreRuntimeErrors)
+{
+  for (const auto integrator : all_integrators)
+    {
+      BoucWenUniaxial law(parameters(2, integrator), E);
+      double          s[3] = {0.5 * z_y, 1, 0}, sigma = 0;
+      EXPECT_THROW(law.update(std::numeric_limits<double>::quiet_NaN(), sigma, s),
+                   hysteron::RuntimeError);
+      EXPECT_THROW(law.update(std::numeric_limits<double>::infinity(), sigma, s),
+                   hysteron::RuntimeError);
+    }
+  // beta + gamma = 0.05, n = 1: saturation at 20 z_y, approached exponentially,
+  // at a tolerance of 1e-15: more than max_substeps sub-steps.
+  BoucWenParameters p = parameters(1, BoucWenIntegrator::adaptive, 1e-15);
+  p.gamma             = -0.45;
+  BoucWenUniaxial law(p, E);
+  double          s[3] = {0, 1, 0}, sigma = 0;
+  EXPECT_THROW(law.update(400 * z_y, sigma, s), hysteron::RuntimeError);
+}
