@@ -1,3 +1,5 @@
+// property_tree pulls in boost/bind.hpp, which otherwise prints a deprecation note.
+#define BOOST_BIND_GLOBAL_PLACEHOLDERS
 #include <deal.II/base/utilities.h>
 
 #include <boost/property_tree/json_parser.hpp>
