@@ -3,6 +3,7 @@
 
 #include <hysteron/base/exceptions.h>
 #include <hysteron/material/elasticity.h>
+#include <hysteron/material/integer_power.h>
 
 #include <algorithm>
 #include <array>
@@ -104,6 +105,12 @@ namespace hysteron
      * Rate independence: over one increment deps the rates are integrated in the
      * pseudo time s in [0, 1] with eps' = deps.
      * - forward Euler: y1 = y0 + f(y0) (Fig. 4.18 with eq. 4.51), tangent E_t(y0).
+     *   Without degradation BoucWen::update() does not call forward_euler() but a
+     *   fused equivalent (FusedForwardEuler in bouc_wen.cc): tensor components read
+     *   and written in place, no square root or division for n and lambda1
+     *   (q^2 form), H1 = (q^2/sigma_y^2)^(n/2) for even n, several points
+     *   interleaved; it agrees with forward_euler() + H1_at() to round-off. The
+     *   stored H1 is still that of the end state.
      * - adaptive: Bogacki-Shampine 3(2), FSAL, first trying h = 1, error norm
      *   max |err_i| / scale_i with scales sigma_y0 (stresses), eps_y (strains),
      *   sigma_y0 eps_y (e_h), step factor 0.9 (tol/err)^(1/3) in [0.2, 5]; a
@@ -265,19 +272,7 @@ namespace hysteron
       inline double
       power(const Constants &c, const double x)
       {
-        if (c.n_integer == 0)
-          return std::pow(x, c.n);
-        double       result = 1, base = x;
-        unsigned int e = c.n_integer;
-        while (true)
-          {
-            if (e & 1u)
-              result *= base;
-            e >>= 1;
-            if (e == 0)
-              return result;
-            base *= base;
-          }
+        return c.n_integer == 0 ? std::pow(x, c.n) : integer_power(x, c.n_integer);
       }
 
       inline double

@@ -2,6 +2,7 @@
 #define hysteron_material_bouc_wen_uniaxial_h
 
 #include <hysteron/material/bouc_wen_parameters.h>
+#include <hysteron/material/integer_power.h>
 
 #include <algorithm>
 #include <array>
@@ -295,19 +296,7 @@ namespace hysteron
       {
         const double ax = std::abs(x);
         if (n_integer > 0)
-          {
-            double       result = 1, base = ax;
-            unsigned int e = n_integer;
-            while (true)
-              {
-                if (e & 1u)
-                  result *= base;
-                e >>= 1;
-                if (e == 0)
-                  return result;
-                base *= base;
-              }
-          }
+          return integer_power(ax, n_integer);
         return std::pow(ax, n);
       }
 
