@@ -169,7 +169,7 @@ int
 main(int argc, char **argv)
 {
   Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
-  unsigned int repeats = 5, points = 1000, steps_per_cycle = 200;
+  unsigned int repeats = 5, points = 1000, steps_per_cycle = 600;
   std::string  csv_file = "material_updates.csv";
   for (int i = 1; i + 1 < argc; i += 2)
     {

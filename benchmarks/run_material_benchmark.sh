@@ -11,13 +11,13 @@ grep -q 'CMAKE_BUILD_TYPE:STRING=Release' "$build/CMakeCache.txt" ||
 out="$root/doc/benchmarks"
 mkdir -p "$out"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-"$build/benchmarks/material_updates" --repeats 5 --points 1000 --steps 200 \
+"$build/benchmarks/material_updates" --repeats 5 --points 1000 --steps 600 \
   --csv "$out/material_updates.csv" > "$out/material_updates.table.md"
 /usr/bin/python3 "$root/benchmarks/report_material_updates.py" "$out/material_updates.csv" \
   "$out/material_updates.png"
 {
   echo "Machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs);"
-  echo "build: Release (deal.II $(grep -o 'DEAL_II_PACKAGE_VERSION "[^"]*"' /usr/include/deal.II/base/config.h | cut -d'"' -f2)), 1 core, median of 5 runs of 1000 points x 400 steps;"
+  echo "build: Release (deal.II $(grep -o 'DEAL_II_PACKAGE_VERSION "[^"]*"' /usr/include/deal.II/base/config.h | cut -d'"' -f2)), 1 core, median of 5 runs of 1000 points x 1200 steps (increments about eps_y/20);"
   echo "date: $(date -u +%Y-%m-%d). Command: benchmarks/run_material_benchmark.sh"
   echo
   cat "$out/material_updates.table.md"
