@@ -495,7 +495,7 @@ namespace hysteron
             else if constexpr (integrator == BoucWenIntegrator::adaptive)
               {
                 typename L::Rates r;
-                L::adaptive(c, y, deps, r);
+                L::adaptive(c, y, deps, r, want_tangent);
                 H1 = r.H1;
                 H2 = r.H2;
                 if (want_tangent)

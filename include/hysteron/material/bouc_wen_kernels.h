@@ -452,6 +452,76 @@ namespace hysteron
             dy[i_eps_zz] = r.eta * (-c.nu / c.E * (dy[0] + dy[1]) + dy[i_epsp + 2]);
         }
 
+        /**
+         * dy = f(y) as rates(), for the inner stages of adaptive(): the rates only
+         * (no Rates filled), in the q^2 form of FusedForwardEuler. With
+         * d = dev(xi), q^2 = 3/2 d:d, n = 3/2 d / q:
+         *   lambda' n = g d, lambda' D n = g D d, |lambda'| = 2/3 |g| q,
+         *   g = nu_s H1 H2 9/4 d:De / (eta (H' q^2 + 9/4 d:D:d)),
+         * which equals rates() up to round-off with one square root and one
+         * division fewer (no n, no lambda1). Returns H1; @p info (if given): q,
+         * sigma_y, H1, H2 and nu_s of the state.
+         */
+        static double
+        stage_rates(const Constants &c,
+                    const double    *y,
+                    const VecK      &De,
+                    double          *dy,
+                    Rates           *info = nullptr)
+        {
+          VecF xi;
+          for (unsigned int f = 0; f < F; ++f)
+            xi[f] = kinematic ? -c.kin * y[i_epsp + f] : 0.0;
+          for (unsigned int a = 0; a < K; ++a)
+            xi[G::full[a]] += y[a];
+          const double p = (xi[0] + xi[1] + xi[2]) * (1.0 / 3.0);
+          xi[0] -= p;
+          xi[1] -= p;
+          xi[2] -= p;
+          const double q2 = 1.5 * dot<F>(xi.data(), xi.data());
+          VecK         d_K, Dd;
+          for (unsigned int a = 0; a < K; ++a)
+            d_K[a] = xi[G::full[a]];
+          apply_D(c, d_K.data(), Dd.data());
+          double       eta = 1, nu = 1;
+          const double sigma_y = c.sigma_y0 + c.iso * y[i_eps_ps];
+          if (degrading)
+            {
+              eta = eta_of(c, y[i_eps_ps]);
+              nu  = 1.0 + c.c_nu_scaled * y[i_e_h];
+            }
+          double g = 0, H1 = 0, q = 0, H2 = c.beta;
+          if (q2 > 0)
+            {
+              q               = std::sqrt(q2);
+              const double dDd = dot<K>(d_K.data(), Dd.data());
+              const double dDe = dot<K>(d_K.data(), De.data());
+              H1               = power(c, q / sigma_y);
+              H2               = c.beta + c.gamma * sign(dDe);
+              const double den = c.H * q2 + 2.25 * dDd;
+              g                = nu * H1 * H2 * 2.25 * dDe / (degrading ? eta * den : den);
+            }
+          for (unsigned int a = 0; a < K; ++a)
+            dy[a] = (degrading ? De[a] / eta : De[a]) - g * Dd[a];
+          for (unsigned int f = 0; f < F; ++f)
+            dy[i_epsp + f] = g * xi[f];
+          dy[i_eps_ps] = std::abs(g) * q * (2.0 / 3.0);
+          if (degrading)
+            dy[i_e_h] = g * dot<K>(y, d_K.data());
+          if (track_eps_zz)
+            dy[i_eps_zz] = eta * (-c.nu / c.E * (dy[0] + dy[1]) + dy[i_epsp + 2]);
+          if (info)
+            {
+              info->q       = q;
+              info->sigma_y = sigma_y;
+              info->H1      = H1;
+              info->H2      = H2;
+              info->nu      = nu;
+              info->eta     = eta;
+            }
+          return H1;
+        }
+
         /// E_t = (D - nu_s H1 H2 lambda1 (D n) (x) (D n)) / eta (eq. 2.47, Mandel).
         static void
         continuum_tangent(const Constants &c, const Rates &r, MatK &T)
@@ -569,16 +639,24 @@ namespace hysteron
         /**
          * Bogacki-Shampine 3(2) with first-same-as-last and error control over the
          * pseudo time s in [0, 1]; r: the rates at the end state. Returns the
-         * number of attempted sub-steps.
+         * number of attempted sub-steps. With @p full_rates = false only r.q,
+         * r.sigma_y, r.H1, r.H2, r.nu and r.eta are set (enough to store the state;
+         * the tangent needs the full Rates).
          */
         static unsigned int
-        adaptive(const Constants &c, VecN &y, const VecK &deps, Rates &r)
+        adaptive(const Constants &c,
+                 VecN            &y,
+                 const VecK      &deps,
+                 Rates           &r,
+                 const bool       full_rates = true)
         {
           VecK De;
           apply_D(c, deps.data(), De.data());
           VecN  k1, k2, k3, k4, yt, y_new, err;
-          Rates r_stage, r_new;
-          rates(c, y.data(), De, k1.data(), r);
+          // Only the end state's Rates are needed (tangent, drift correction,
+          // stored H1 and H2): all stages use stage_rates(); rates() is evaluated
+          // once at the end state if the drift correction or the caller needs it.
+          double H1_now = stage_rates(c, y.data(), De, k1.data());
           double       s = 0, h = 1;
           unsigned int attempts = 0;
           while (true)
@@ -588,7 +666,7 @@ namespace hysteron
                   std::ostringstream m;
                   m << "Bouc-Wen (adaptive integrator): more than " << c.max_substeps
                     << " sub-steps for one strain increment (reached s = " << s << ", sub-step "
-                    << h << ", H1 = " << r.H1
+                    << h << ", H1 = " << H1_now
                     << "). Reduce the strain increment or raise Material/Bouc-Wen/Tolerance.";
                   throw RuntimeError(m.str());
                 }
@@ -597,13 +675,16 @@ namespace hysteron
                 h = 1.0 - s;
               for (unsigned int i = 0; i < N; ++i)
                 yt[i] = y[i] + 0.5 * h * k1[i];
-              rates(c, yt.data(), De, k2.data(), r_stage);
+              stage_rates(c, yt.data(), De, k2.data());
               for (unsigned int i = 0; i < N; ++i)
                 yt[i] = y[i] + 0.75 * h * k2[i];
-              rates(c, yt.data(), De, k3.data(), r_stage);
+              stage_rates(c, yt.data(), De, k3.data());
               for (unsigned int i = 0; i < N; ++i)
                 y_new[i] = y[i] + h * (2.0 / 9.0 * k1[i] + 1.0 / 3.0 * k2[i] + 4.0 / 9.0 * k3[i]);
-              rates(c, y_new.data(), De, k4.data(), r_new);
+              const bool   full_new = last && full_rates;
+              const double H1_new   = full_new ?
+                                        (rates(c, y_new.data(), De, k4.data(), r), r.H1) :
+                                        stage_rates(c, y_new.data(), De, k4.data(), &r);
               for (unsigned int i = 0; i < N; ++i)
                 err[i] = h * (-5.0 / 72.0 * k1[i] + 1.0 / 12.0 * k2[i] + 1.0 / 9.0 * k3[i] -
                               0.125 * k4[i]);
@@ -626,12 +707,22 @@ namespace hysteron
                 }
               else if (e <= 1.0)
                 {
-                  y  = y_new;
-                  k1 = k4;
-                  r  = r_new;
+                  y      = y_new;
+                  k1     = k4;
+                  H1_now = H1_new;
                   if (last)
                     {
-                      drift_correction(c, y, r);
+                      // r: the full Rates of y, or q, sigma_y, nu_s (stage_rates()).
+                      const double target =
+                        r.sigma_y * (degrading ? std::pow(r.nu, -1.0 / c.n) : 1.0);
+                      const bool drift = r.q > target * (1 + 1e-14);
+                      if (drift && !full_new)
+                        {
+                          VecN dy;
+                          rates(c, y.data(), De, dy.data(), r);
+                        }
+                      if (drift)
+                        drift_correction(c, y, r);
                       return attempts;
                     }
                   s += h;
@@ -644,7 +735,7 @@ namespace hysteron
                   std::ostringstream m;
                   m << "Bouc-Wen (adaptive integrator): the sub-step fell below 1e-13 of the "
                        "increment at s = "
-                    << s << " (H1 = " << r.H1
+                    << s << " (H1 = " << H1_now
                     << "): the tolerance cannot be met in double precision. Raise "
                        "Material/Bouc-Wen/Tolerance.";
                   throw RuntimeError(m.str());
