@@ -647,22 +647,29 @@ namespace hysteron
 
     template <int dim>
     void
-    BoucWen<dim>::out_of_plane(const dealii::SymmetricTensor<2, dim> &,
+    BoucWen<dim>::out_of_plane(const dealii::SymmetricTensor<2, dim> &strain,
                                const dealii::SymmetricTensor<2, dim> &stress,
                                const dealii::ArrayView<const double> &state,
                                double                                &eps_zz,
                                double                                &sigma_zz) const
     {
-      eps_zz   = 0;
-      sigma_zz = 0;
-      if (dim != 2)
-        return;
-      if (stress_state == StressState::plane_strain)
-        sigma_zz = state[slot_sigma_zz];
-      else if (degrading)
-        eps_zz = state[slot_eps_zz];
-      else // elastic part of sigma_zz = 0 plus the plastic part
-        eps_zz = -constants.nu / constants.E * (stress[0][0] + stress[1][1]) + state[slot_epsp_zz];
+      if (dim == 2 && stress_state == StressState::plane_strain)
+        {
+          eps_zz   = 0;
+          sigma_zz = state[slot_sigma_zz];
+        }
+      else if (dim == 2 && degrading)
+        {
+          sigma_zz = 0;
+          eps_zz   = state[slot_eps_zz];
+        }
+      else
+        {
+          // The elastic part (sigma_zz = 0) plus the plastic part of eps_zz (zero in 3D).
+          Interface<dim>::out_of_plane(strain, stress, state, eps_zz, sigma_zz);
+          if (dim == 2)
+            eps_zz += state[slot_epsp_zz];
+        }
     }
 
     template class BoucWen<2>;
