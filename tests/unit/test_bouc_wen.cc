@@ -543,22 +543,39 @@ peaks(const History<dim>  &h,
     }
 }
 
+namespace
+{
+  /// Three uniaxial-stress cycles of amplitude 5 eps_y (n = 8, a = 0.05, hardening fraction m,
+  /// 400 steps per cycle): the history and the peak/valley stress of every cycle.
+  struct ThreeCycles
+  {
+    std::unique_ptr<Material::Interface<3>> mat;
+    History<3>                              h;
+    std::vector<double>                     mx, mn;
+    static constexpr unsigned int           steps = 400;
+
+    explicit ThreeCycles(const std::string &m)
+      : mat(make_material<3>({{"Smoothness n", "8"},
+                              {"Post-yield stiffness ratio", "0.05"},
+                              {"Isotropic hardening fraction", m}}))
+    {
+      Driver<3> d(*mat, uniaxial_free<3>());
+      h = run<3>(
+        d,
+        [](const double t) { return eps_xx<3>(5 * eps_y_ * std::sin(2 * M_PI * t)); },
+        3.0,
+        3 * steps);
+      peaks(h, steps, mx, mn);
+    }
+  };
+} // namespace
+
 TEST(BoucWenTriaxialHardening, IsotropicLoopsGrowSymmetrically)
 {
-  const auto         mat = make_material<3>({{"Smoothness n", "8"},
-                                             {"Post-yield stiffness ratio", "0.05"},
-                                             {"Isotropic hardening fraction", "1"}});
-  Driver<3>          d(*mat, uniaxial_free<3>());
-  const unsigned int steps = 400;
-  const auto         h     = run<3>(
-    d,
-    [](const double t) {
-      return eps_xx<3>(5 * eps_y_ * std::sin(2 * M_PI * t));
-    },
-    3.0,
-    3 * steps);
-  std::vector<double> mx, mn;
-  peaks(h, steps, mx, mn);
+  ThreeCycles         cycles("1");
+  const auto         &h = cycles.h;
+  const auto         &mx = cycles.mx, &mn = cycles.mn;
+  const unsigned int  steps = ThreeCycles::steps;
   ASSERT_EQ(mx.size(), 3u);
   // Each half cycle adds plastic strain, so every peak exceeds the previous one in magnitude:
   // mx[0] < |mn[0]| < mx[1] < |mn[1]| < mx[2] < |mn[2]|.
@@ -573,27 +590,15 @@ TEST(BoucWenTriaxialHardening, IsotropicLoopsGrowSymmetrically)
   EXPECT_GT(mx[2], 1.05 * mx[0]);
   // The surface stays centred: reversing at sigma_peak, yield resumes at -sigma_peak.
   const double sigma_peak = h.stress[steps / 4][0][0];
-  const double reverse    = reverse_yield_stress(h, *mat, steps / 4, 8);
+  const double reverse    = reverse_yield_stress(h, *cycles.mat, steps / 4, 8);
   EXPECT_GE(reverse, -sigma_peak);
   EXPECT_LE(reverse, -sigma_peak + 0.1 * sy_);
 }
 
 TEST(BoucWenTriaxialHardening, KinematicLoopsAreSymmetricAndStable)
 {
-  const auto         mat = make_material<3>({{"Smoothness n", "8"},
-                                             {"Post-yield stiffness ratio", "0.05"},
-                                             {"Isotropic hardening fraction", "0"}});
-  Driver<3>          d(*mat, uniaxial_free<3>());
-  const unsigned int steps = 400;
-  const auto         h     = run<3>(
-    d,
-    [](const double t) {
-      return eps_xx<3>(5 * eps_y_ * std::sin(2 * M_PI * t));
-    },
-    3.0,
-    3 * steps);
-  std::vector<double> mx, mn;
-  peaks(h, steps, mx, mn);
+  ThreeCycles cycles("0");
+  const auto &mx = cycles.mx, &mn = cycles.mn;
   // Translation only: after the first half cycle the loop is symmetric and repeats.
   EXPECT_NEAR(mx[1] / -mn[1], 1.0, 1e-3);
   EXPECT_NEAR(mx[2] / mx[1], 1.0, 1e-4);
