@@ -114,14 +114,36 @@ namespace hysteron
                  const bool         time_dependent,
                  const std::string &where)
   {
+    return parse_vector_function<dim>(expression, 1, variables, time_dependent, where);
+  }
+
+  template <int dim>
+  std::unique_ptr<dealii::FunctionParser<dim>>
+  parse_vector_function(const std::string &expression,
+                        const unsigned int n_components,
+                        const std::string &variables,
+                        const bool         time_dependent,
+                        const std::string &where)
+  {
     require(!dealii::Utilities::trim(expression).empty(), where, "the expression is empty");
-    auto function = std::make_unique<dealii::FunctionParser<dim>>(1);
+    const auto components = dealii::Utilities::split_string_list(expression, ';');
+    require(components.size() == n_components,
+            where,
+            "'" + expression + "' has " + std::to_string(components.size()) +
+              " component(s) separated by ';', " + std::to_string(n_components) +
+              " expected");
+    for (const auto &c : components)
+      require(!c.empty(), where, "an empty component in '" + expression + "'");
+    auto function = std::make_unique<dealii::FunctionParser<dim>>(n_components);
     const std::map<std::string, double> constants{{"pi", M_PI}, {"e", M_E}};
     try
       {
-        function->initialize(variables, expression, constants, time_dependent);
-        const double v = function->value(dealii::Point<dim>());
-        (void)v;
+        function->initialize(variables, components, constants, time_dependent);
+        for (unsigned int c = 0; c < n_components; ++c)
+          {
+            const double v = function->value(dealii::Point<dim>(), c);
+            (void)v;
+          }
       }
     catch (const dealii::ExceptionBase &e)
       {
@@ -163,8 +185,14 @@ namespace hysteron
 
   template std::unique_ptr<dealii::FunctionParser<1>>
   parse_function<1>(const std::string &, const std::string &, bool, const std::string &);
+  template std::unique_ptr<dealii::FunctionParser<1>>
+  parse_vector_function<1>(const std::string &, unsigned int, const std::string &, bool, const std::string &);
   template std::unique_ptr<dealii::FunctionParser<2>>
   parse_function<2>(const std::string &, const std::string &, bool, const std::string &);
+  template std::unique_ptr<dealii::FunctionParser<2>>
+  parse_vector_function<2>(const std::string &, unsigned int, const std::string &, bool, const std::string &);
   template std::unique_ptr<dealii::FunctionParser<3>>
   parse_function<3>(const std::string &, const std::string &, bool, const std::string &);
+  template std::unique_ptr<dealii::FunctionParser<3>>
+  parse_vector_function<3>(const std::string &, unsigned int, const std::string &, bool, const std::string &);
 } // namespace hysteron

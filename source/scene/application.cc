@@ -64,7 +64,7 @@ namespace hysteron
     struct Preamble
     {
       unsigned int             dimension = 2;
-      std::vector<std::string> material_names;
+      SceneNames               names;
     };
 
     /// Read Dimension, Material names and libraries, skipping everything else.
@@ -77,7 +77,7 @@ namespace hysteron
 
       Preamble p;
       p.dimension      = prm.get_integer("Dimension");
-      p.material_names = parse_names(prm.get("Material names"), "Material names");
+      p.names     = SceneNames::read(prm);
       for (const auto &library : dealii::Utilities::split_string_list(
              prm.get("Additional shared libraries"), ','))
         if (!library.empty())
@@ -170,9 +170,9 @@ namespace hysteron
 
       dealii::ParameterHandler prm;
       if (preamble.dimension == 2)
-        Scene<2>::declare_parameters(prm, preamble.material_names);
+        Scene<2>::declare_parameters(prm, preamble.names);
       else
-        Scene<3>::declare_parameters(prm, preamble.material_names);
+        Scene<3>::declare_parameters(prm, preamble.names);
 
       if (!files.empty())
         try

@@ -29,6 +29,21 @@ namespace hysteron
                       "Names of further materials, besides the default one of `subsection "
                       "Material`. Each name N gets its own `subsection Material N` with the same "
                       "entries; bodies refer to materials by name.");
+    prm.declare_entry("Body names",
+                      "",
+                      Patterns::List(Patterns::Anything()),
+                      "Names of the bodies of a field method (mpm, fem, rbsn); each name N gets "
+                      "`subsection Body N` with its shape, material, thickness and velocity.");
+    prm.declare_entry("Boundary names",
+                      "",
+                      Patterns::List(Patterns::Anything()),
+                      "Names of the kinematic boundary conditions; each name N gets `subsection "
+                      "Boundary N`.");
+    prm.declare_entry("Load names",
+                      "",
+                      Patterns::List(Patterns::Anything()),
+                      "Names of the loads (forces, tractions); each name N gets `subsection Load "
+                      "N`.");
     prm.declare_entry("Additional shared libraries",
                       "",
                       Patterns::List(Patterns::FileName()),
@@ -45,8 +60,7 @@ namespace hysteron
 
   template <int dim>
   void
-  Scene<dim>::declare_parameters(dealii::ParameterHandler       &prm,
-                                 const std::vector<std::string> &material_names)
+  Scene<dim>::declare_parameters(dealii::ParameterHandler &prm, const SceneNames &names)
   {
     using namespace dealii;
     declare_preamble(prm);
@@ -55,6 +69,11 @@ namespace hysteron
                       Patterns::Integer(0),
                       "Seed of every random number generator (point sets, perturbations): the "
                       "same seed gives the same results.");
+    prm.declare_entry("Gravity",
+                      "",
+                      Patterns::Anything(),
+                      "Acceleration of gravity [m/s^2] acting on every body of a field method, "
+                      "as 'gx, gy' (2D) or 'gx, gy, gz' (3D); empty: none.");
 
     prm.enter_subsection("Time");
     {
@@ -100,7 +119,7 @@ namespace hysteron
     prm.leave_subsection();
 
     std::vector<std::string> sections{""};
-    sections.insert(sections.end(), material_names.begin(), material_names.end());
+    sections.insert(sections.end(), names.materials.begin(), names.materials.end());
     for (const auto &name : sections)
       {
         prm.enter_subsection(material_subsection(name));
@@ -108,6 +127,7 @@ namespace hysteron
         prm.leave_subsection();
       }
 
+    declare_scene_descriptions(prm, names);
     Methods::Registry<3>::declare_parameters(prm);
   }
 
@@ -174,9 +194,9 @@ namespace hysteron
       output.progress_interval = s.get_positive("Progress interval");
     }
 
+    const SceneNames scene_names = SceneNames::read(prm);
     std::vector<std::string> names{""};
-    const auto extra = parse_names(prm.get("Material names"), "Material names");
-    names.insert(names.end(), extra.begin(), extra.end());
+    names.insert(names.end(), scene_names.materials.begin(), scene_names.materials.end());
     for (const auto &name : names)
       {
         Section s(prm, {material_subsection(name)});
@@ -185,6 +205,13 @@ namespace hysteron
           for (const auto &w : materials[name]->warnings())
             std::cerr << "hysteron: warning: " << w << std::endl;
       }
+
+    gravity_vector = parse_vector<dim>(prm.get("Gravity"), "Gravity");
+    bodies         = parse_bodies<dim>(prm, scene_names);
+    for (const auto &b : bodies)
+      material(b.material, "Body " + b.name + "/Material");
+    boundaries = parse_boundaries<dim>(prm, scene_names);
+    loads      = parse_loads<dim>(prm, scene_names);
 
     std::ostringstream text;
     prm.print_parameters(text, dealii::ParameterHandler::ShortPRM);

@@ -89,6 +89,18 @@ namespace hysteron
                  const bool         time_dependent,
                  const std::string &where);
 
+  /**
+   * As parse_function(), for a vector of @p n_components components separated
+   * by ';' ("0; -9.81"). A wrong number of components is an InputError.
+   */
+  template <int dim>
+  std::unique_ptr<dealii::FunctionParser<dim>>
+  parse_vector_function(const std::string &expression,
+                        const unsigned int n_components,
+                        const std::string &variables,
+                        const bool         time_dependent,
+                        const std::string &where);
+
   /// Names in a top-level list entry such as "Material names" (validated: no
   /// duplicates, no empty names, no characters that would break a subsection name).
   std::vector<std::string>

@@ -8,6 +8,7 @@
 #include <deal.II/base/timer.h>
 
 #include <hysteron/material/interface.h>
+#include <hysteron/scene/description.h>
 #include <hysteron/scene/method.h>
 
 #include <map>
@@ -66,8 +67,7 @@ namespace hysteron
   public:
     /// Every entry of every module (all methods, all material models).
     static void
-    declare_parameters(dealii::ParameterHandler       &prm,
-                       const std::vector<std::string> &material_names);
+    declare_parameters(dealii::ParameterHandler &prm, const SceneNames &names);
 
     /// Parse and validate everything, including the method's own parameters.
     Scene(dealii::ParameterHandler &prm, const RunOptions &options);
@@ -81,6 +81,32 @@ namespace hysteron
 
     std::vector<std::string>
     material_names() const;
+
+    /// The bodies, boundary conditions and loads of the field methods (validated).
+    const std::vector<BodyDescription<dim>> &
+    body_descriptions() const
+    {
+      return bodies;
+    }
+
+    const std::vector<BoundaryDescription<dim>> &
+    boundary_descriptions() const
+    {
+      return boundaries;
+    }
+
+    const std::vector<LoadDescription<dim>> &
+    load_descriptions() const
+    {
+      return loads;
+    }
+
+    /// `Gravity` [m/s^2].
+    const dealii::Tensor<1, dim> &
+    gravity() const
+    {
+      return gravity_vector;
+    }
 
     const TimeControl &
     time_control() const
@@ -144,6 +170,10 @@ namespace hysteron
     mutable dealii::TimerOutput                                     computing_timer;
     std::string                                                     method_name;
     std::map<std::string, std::unique_ptr<Material::Interface<dim>>> materials;
+    std::vector<BodyDescription<dim>>                               bodies;
+    std::vector<BoundaryDescription<dim>>                           boundaries;
+    std::vector<LoadDescription<dim>>                               loads;
+    dealii::Tensor<1, dim>                                          gravity_vector;
     TimeControl                                                     time;
     OutputControl<dim>                                              output;
     unsigned int                                                    seed = 0;

@@ -1,0 +1,230 @@
+#ifndef hysteron_mpm_mpm_h
+#define hysteron_mpm_mpm_h
+
+#include <deal.II/fe/mapping_cartesian.h>
+#include <deal.II/particles/particle_handler.h>
+
+#include <hysteron/base/output.h>
+#include <hysteron/mpm/grid.h>
+#include <hysteron/mpm/particles.h>
+#include <hysteron/scene/method.h>
+#include <hysteron/scene/scene.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace hysteron
+{
+  namespace MPM
+  {
+    /// When the stress is updated in a step (dissertation §4.4).
+    enum class Scheme
+    {
+      musl, ///< modified update stress last: nodal velocities remapped from the updated points
+      usl,  ///< update stress last, from the updated nodal velocities
+      usf   ///< update stress first, from the nodal velocities of the step's start
+    };
+
+    /**
+     * The explicit Material Point Method (`set Method = mpm`), dissertation
+     * chapter 4: bodies filled with material points that carry mass, velocity,
+     * stress and the Bouc–Wen state; a fixed Cartesian background grid on which
+     * the momentum equation is solved each step.
+     *
+     * One step (MUSL, §4.2) with shape functions N_i(x_p) of the step's start:
+     *  1. P2G: m_i = sum_p N_ip m_p, p_i = sum_p N_ip m_p v_p,
+     *     f_i = -sum_p V_p sigma_p grad N_ip + sum_p N_ip (m_p g + f_p);
+     *  2. nodes: v_i = p_i / m_i, v_i' = v_i + dt f_i / m_i, boundary conditions on v_i';
+     *  3. G2P: v_p' = alpha (v_p + sum N_ip (v_i' - v_i)) + (1 - alpha) sum N_ip v_i'
+     *     (alpha: FLIP fraction), x_p' = x_p + dt sum N_ip v_i';
+     *  4. MUSL: p_i = sum N_ip m_p v_p', v_i = p_i / m_i with boundary conditions;
+     *  5. L_p = sum_i v_i (x) grad N_ip, d eps = sym(L_p) dt, F' = (I + L dt) F,
+     *     V' = det F' V_0, stress and state by the material (optionally the
+     *     Jaumann rotation sigma += (W sigma - sigma W) dt, W = skew L).
+     * USL takes v_i' in step 5 without the remap; USF updates the stress with
+     * the velocities p_i / m_i of step 1 before the forces are computed.
+     *
+     * The kernels are templates of the basis (linear, cubic B-spline): the
+     * basis and the scheme are chosen once per step.
+     */
+    template <int dim>
+    class Solver : public Methods::Interface<dim>
+    {
+    public:
+      Solver();
+      ~Solver() override;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+
+      void
+      run() override;
+
+      std::string
+      summary() const override;
+
+      /// One step from t to t + dt with the basis @p Basis (a 1D kernel of basis.h).
+      template <typename Basis>
+      void
+      advance(const double t, const double dt);
+
+    protected:
+      void
+      parse_parameters(dealii::ParameterHandler &prm) override;
+
+    private:
+      struct BoundaryNodes
+      {
+        std::string               name;
+        unsigned int              type = 0; ///< BoundaryDescription::Type
+        std::vector<unsigned int> nodes;    ///< local grid nodes
+        std::vector<int>          normal_sign; ///< wall: +1 / -1 per node (lower / upper face)
+        std::vector<unsigned int> normal_direction;
+        std::vector<bool>         components;
+        const dealii::FunctionParser<1> *velocity = nullptr;
+      };
+
+      struct Probe
+      {
+        dealii::Point<dim>            point;
+        dealii::types::particle_index id = 0;
+        dealii::Point<dim>            initial_position;
+        int                           local = -1; ///< index in the store, -1 if not on this rank
+      };
+
+      // Parameters.
+      dealii::Point<dim>            lower, upper;
+      double                        cell_size = 0;
+      std::array<unsigned int, dim> n_cells;
+      std::string                   basis_name;
+      Scheme                        scheme = Scheme::musl;
+      double                        flip_fraction = 1.0;
+      bool                          jaumann       = false;
+      double                        maximum_cfl   = 1.0;
+      double                        probe_interval = 0.0;
+      double                        small_mass = 0; ///< nodes lighter than this have no velocity
+
+      // Set-up and the pieces of run().
+      void
+      setup_grid();
+      void
+      generate_particles();
+      void
+      setup_boundaries();
+      void
+      from_handler();
+      void
+      to_handler();
+      void
+      locate_probes();
+      double
+      critical_time_step() const;
+      void
+      check_step(const double dt, const double t) const;
+      void
+      write_fields(const double t);
+      void
+      open_tables();
+      void
+      write_table_rows(const double t);
+      void
+      commit_tables();
+      [[noreturn]] void
+      fail(const std::string &what, const double t);
+      /// The failure of the last step, described on every rank (from the rank that saw it).
+      std::string
+      describe_failure(const double t) const;
+      void
+      apply_boundary_conditions(const double t, const double dt, const bool record_reactions);
+      bool
+      needs_migration() const;
+
+      /// Strains, deformation gradients, volumes and stresses from the nodal velocities.
+      template <typename Basis>
+      void
+      update_stresses(const double dt);
+
+      /// Record the cell of point p at its new position @p x (or the failure).
+      void
+      track_cell(const unsigned int p, const dealii::Point<dim> &x)
+      {
+        const Lattice<dim> &lattice = grid->lattice();
+        bool                finite  = true;
+        for (unsigned int d = 0; d < dim; ++d)
+          finite = finite && std::isfinite(x[d]);
+        if (!finite || !lattice.contains(x))
+          {
+            if (failed_point < 0)
+              {
+                failed_point = p;
+                failure      = finite ? "a material point left the grid" :
+                                        "a non-finite position";
+              }
+            return;
+          }
+        const unsigned int id = grid->cell_id(lattice.cell_of(x));
+        if (id != particles.cell[p])
+          {
+            particles.cell[p] = id;
+            ++n_changed_cells;
+            if (!grid->owns_cell(id))
+              left_subdomain = true;
+          }
+      }
+
+      std::unique_ptr<BackgroundGrid<dim>>               grid;
+      dealii::MappingCartesian<dim>                      mapping;
+      std::unique_ptr<dealii::Particles::ParticleHandler<dim>> handler;
+      ParticleStore<dim>                                 particles;
+      std::vector<BoundaryNodes>                         boundaries;
+      std::vector<Probe>                                 probes;
+      std::vector<dealii::Tensor<1, dim>>                load_per_point; ///< per load, at t
+      std::vector<double>                                load_scale;     ///< 1 / count or area
+      std::vector<std::vector<double>>                   particle_load_area;
+
+      // Nodes touched this step (their stamp is the step number).
+      std::vector<unsigned int> active_nodes;
+      std::vector<unsigned int> node_stamp;
+      std::vector<unsigned int> rigid_node_body; ///< 1 + rigid body index at a node, 0 none
+      std::vector<unsigned int> rigid_nodes;
+      unsigned int              stamp = 0;
+
+      // Per step scratch.
+      std::vector<dealii::SymmetricTensor<2, dim>> strain_increment;
+
+      // Diagnostics of the last step.
+      double       max_speed            = 0; ///< max_p (c_p + |v_p|)
+      double       internal_work        = 0; ///< sum V sigma : d eps (this rank)
+      double       external_work        = 0; ///< gravity and loads (this rank)
+      double       boundary_work        = 0; ///< reactions times prescribed velocities (owned nodes)
+      std::vector<dealii::Tensor<1, dim>> reactions; ///< per boundary, then per rigid body
+      long         failed_point         = -1;
+      std::string  failure;
+      unsigned int n_changed_cells      = 0;
+      bool         left_subdomain       = false;
+
+      // Bookkeeping.
+      unsigned long                                 n_steps = 0;
+      unsigned int                                  n_outputs = 0;
+      unsigned int                                  n_rebuilds = 0;
+      std::unique_ptr<Output::FieldWriter>          field_writer;
+      std::vector<std::unique_ptr<Output::CsvWriter>> probe_tables;
+      std::unique_ptr<Output::CsvWriter>            energy_table;
+      std::unique_ptr<Output::CsvWriter>            reaction_table;
+      std::vector<std::string>                      state_names;
+      std::vector<unsigned int>                     group_of_body;
+      std::vector<typename ParticleStore<dim>::Group> group_templates;
+      unsigned int                                  current_group_key = 0;
+      unsigned int                                  n_properties      = 0;
+      std::vector<unsigned long>                    load_count; ///< points per load (index 0: none)
+      bool                                          energy_logged   = false;
+      double                                        initial_kinetic = 0;
+      double                                        initial_strain  = 0;
+      dealii::types::particle_index                 n_global_particles = 0;
+    };
+  } // namespace MPM
+} // namespace hysteron
+
+#endif

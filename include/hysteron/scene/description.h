@@ -1,0 +1,133 @@
+#ifndef hysteron_scene_description_h
+#define hysteron_scene_description_h
+
+#include <deal.II/base/function_parser.h>
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
+#include <deal.II/base/tensor.h>
+
+#include <hysteron/base/parameters.h>
+#include <hysteron/geometry/region.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace hysteron
+{
+  /**
+   * The names of the named subsections of a scene, read in the pre-pass:
+   * `Material names`, `Body names`, `Boundary names`, `Load names`. Each name N
+   * gets `subsection Material N` (resp. `Body N`, `Boundary N`, `Load N`).
+   */
+  struct SceneNames
+  {
+    std::vector<std::string> materials;
+    std::vector<std::string> bodies;
+    std::vector<std::string> boundaries;
+    std::vector<std::string> loads;
+
+    /// Read the four lists (declared by declare_preamble()) from @p prm.
+    static SceneNames
+    read(const dealii::ParameterHandler &prm);
+  };
+
+  /**
+   * `subsection Body <name>`: a solid of one material, its shape, its initial
+   * velocity and (in 2D) its out-of-plane thickness. A rigid body moves with a
+   * prescribed velocity and carries no stress (MPM: it imposes its velocity on
+   * the grid nodes it touches).
+   */
+  template <int dim>
+  struct BodyDescription
+  {
+    std::string                                   name;
+    std::string                                   material; ///< "" is the default material
+    Geometry::Region<dim>                         shape;
+    unsigned int                                  particles_per_cell = 2;
+    double                                        thickness          = 1.0;
+    std::shared_ptr<dealii::FunctionParser<dim>>  initial_velocity; ///< of x; null: at rest
+    bool                                          rigid = false;
+    std::shared_ptr<dealii::FunctionParser<1>>    rigid_velocity; ///< of t (rigid bodies)
+
+    dealii::Tensor<1, dim>
+    velocity_at(const dealii::Point<dim> &p) const;
+  };
+
+  /**
+   * `subsection Boundary <name>`: a kinematic condition on the grid (MPM) or
+   * mesh (FEM) nodes on faces of the domain box and/or inside a region.
+   */
+  template <int dim>
+  struct BoundaryDescription
+  {
+    enum class Type
+    {
+      fixed,    ///< every velocity component zero
+      roller,   ///< the normal component zero (faces only)
+      wall,     ///< rigid frictionless wall: the normal component may not point into the wall
+      velocity  ///< the selected components follow functions of t
+    };
+    std::string                                name;
+    Type                                       type = Type::fixed;
+    /// Faces of the domain box: 2 d + (0 for the lower, 1 for the upper face of direction d).
+    std::vector<unsigned int>                  faces;
+    Geometry::Region<dim>                      region; ///< used if has_region
+    bool                                       has_region = false;
+    std::vector<bool>                          components; ///< velocity type: prescribed components
+    std::shared_ptr<dealii::FunctionParser<1>> velocity;   ///< velocity type: of t
+
+    /// "x-", "y+", ... for face f.
+    static std::string
+    face_name(const unsigned int face);
+  };
+
+  /**
+   * `subsection Load <name>`: a force on the particles (MPM) or nodes (FEM) of
+   * a region: a total force split evenly, or a traction per unit of surface.
+   */
+  template <int dim>
+  struct LoadDescription
+  {
+    enum class Type
+    {
+      force,   ///< the total force [N] is shared evenly by the selected points
+      traction ///< force per unit area [Pa] on the selected (surface) points
+    };
+    std::string                                name;
+    Type                                       type = Type::force;
+    Geometry::Region<dim>                      region;
+    std::shared_ptr<dealii::FunctionParser<1>> value; ///< of t, dim components
+
+    dealii::Tensor<1, dim>
+    value_at(const double t) const;
+  };
+
+  /// Declare the entries of the named body, boundary and load subsections.
+  void
+  declare_scene_descriptions(dealii::ParameterHandler &prm, const SceneNames &names);
+
+  template <int dim>
+  std::vector<BodyDescription<dim>>
+  parse_bodies(dealii::ParameterHandler &prm, const SceneNames &names);
+
+  template <int dim>
+  std::vector<BoundaryDescription<dim>>
+  parse_boundaries(dealii::ParameterHandler &prm, const SceneNames &names);
+
+  template <int dim>
+  std::vector<LoadDescription<dim>>
+  parse_loads(dealii::ParameterHandler &prm, const SceneNames &names);
+
+  /// `Gravity` (top level): a vector of dim components [m/s^2]; "" is zero.
+  template <int dim>
+  dealii::Tensor<1, dim>
+  parse_vector(const std::string &text, const std::string &where);
+
+  /// Evaluate a vector function of t (a FunctionParser<1> in the variable t).
+  template <int dim>
+  dealii::Tensor<1, dim>
+  evaluate_in_time(const dealii::FunctionParser<1> &f, const double t);
+} // namespace hysteron
+
+#endif

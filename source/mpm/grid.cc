@@ -1,0 +1,211 @@
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/grid/grid_generator.h>
+
+#include <hysteron/base/exceptions.h>
+#include <hysteron/mpm/grid.h>
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+
+namespace hysteron
+{
+  namespace MPM
+  {
+    template <int dim>
+    BackgroundGrid<dim>::BackgroundGrid(MPI_Comm comm)
+      : comm(comm)
+      , n_ranks(dealii::Utilities::MPI::n_mpi_processes(comm))
+      , tria(comm)
+    {}
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::initialize(const dealii::Point<dim>            &lower,
+                                    const double                          h,
+                                    const std::array<unsigned int, dim> &n_cells,
+                                    const unsigned int                    n_components)
+    {
+      using namespace dealii;
+      grid_lattice.origin  = lower;
+      grid_lattice.h       = h;
+      grid_lattice.n_cells = n_cells;
+      n_comp               = n_components;
+
+      std::vector<unsigned int> repetitions(n_cells.begin(), n_cells.end());
+      Point<dim>                upper = lower;
+      unsigned int              n_lattice_cells = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          upper[d] += n_cells[d] * h;
+          n_lattice_cells *= n_cells[d];
+        }
+      GridGenerator::subdivided_hyper_rectangle(tria, repetitions, lower, upper);
+
+      fe = std::make_unique<FESystem<dim>>(FE_Q<dim>(1), n_comp);
+      dof_handler.reinit(tria);
+      dof_handler.distribute_dofs(*fe);
+
+      // Which lattice cell is which triangulation cell, and who owns it.
+      owned_cell.assign(n_lattice_cells, 0);
+      cell_index.assign(n_lattice_cells, -1);
+      std::array<int, dim> low, high;
+      low.fill(INT_MAX);
+      high.fill(INT_MIN);
+      for (const auto &cell : tria.active_cell_iterators())
+        if (!cell->is_artificial())
+          {
+            std::array<unsigned int, dim> c;
+            const Point<dim>              center = cell->center();
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                c[d] = static_cast<unsigned int>(std::floor((center[d] - lower[d]) / h));
+                low[d]  = std::min<int>(low[d], c[d]);
+                high[d] = std::max<int>(high[d], c[d] + 1);
+              }
+            const unsigned int id = cell_id(c);
+            cell_index[id]        = cell->index();
+            owned_cell[id]        = cell->is_locally_owned() ? 1 : 0;
+          }
+
+      // The dense box of the locally relevant nodes (a rank without cells gets an empty box).
+      n_box_nodes = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          if (high[d] < low[d])
+            low[d] = high[d] = 0;
+          box_low[d]    = low[d];
+          box_size[d]   = high[d] - low[d] + 1;
+          box_stride[d] = n_box_nodes;
+          n_box_nodes *= box_size[d];
+        }
+      relevant_node.assign(n_box_nodes, 0);
+      owned_node.assign(n_box_nodes, 0);
+      nodes.assign(std::size_t(n_box_nodes) * n_comp, 0.0);
+
+      IndexSet relevant;
+      DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
+      const IndexSet &owned = dof_handler.locally_owned_dofs();
+      buffer.reinit(owned, relevant, comm);
+      const auto &partitioner = *buffer.get_partitioner();
+
+      std::vector<int> box_of_local(owned.n_elements() + partitioner.n_ghost_indices(), -1);
+      ghost_nodes.clear();
+      import_nodes.clear();
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (!cell->is_artificial())
+          for (const unsigned int v : cell->vertex_indices())
+            {
+              std::array<int, dim> i;
+              for (unsigned int d = 0; d < dim; ++d)
+                i[d] = static_cast<int>(std::lround((cell->vertex(v)[d] - lower[d]) / h));
+              const unsigned int n = local_node(i);
+              if (relevant_node[n])
+                continue;
+              relevant_node[n]                = 1;
+              const types::global_dof_index g = cell->vertex_dof_index(v, 0);
+              for (unsigned int c = 1; c < n_comp; ++c)
+                Assert(cell->vertex_dof_index(v, c) == g + c, ExcInternalError());
+              owned_node[n]        = owned.is_element(g) ? 1 : 0;
+              const unsigned int l = partitioner.global_to_local(g);
+              box_of_local[l]      = n;
+              if (!owned_node[n])
+                ghost_nodes.emplace_back(n, l);
+            }
+      // Owned nodes that other ranks also touch: their sums arrive through compress().
+      for (const auto &range : partitioner.import_indices())
+        for (unsigned int l = range.first; l < range.second; ++l)
+          if (box_of_local[l] >= 0)
+            import_nodes.emplace_back(box_of_local[l], l);
+      std::sort(import_nodes.begin(), import_nodes.end());
+      import_nodes.erase(std::unique(import_nodes.begin(), import_nodes.end()), import_nodes.end());
+    }
+
+
+
+    template <int dim>
+    typename dealii::Triangulation<dim>::active_cell_iterator
+    BackgroundGrid<dim>::cell_iterator(const unsigned int id) const
+    {
+      Assert(cell_index[id] >= 0, dealii::ExcInternalError());
+      return typename dealii::Triangulation<dim>::active_cell_iterator(&tria, 0, cell_index[id]);
+    }
+
+
+
+    template <int dim>
+    std::array<int, dim>
+    BackgroundGrid<dim>::lattice_index(unsigned int n) const
+    {
+      std::array<int, dim> i;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          i[d] = box_low[d] + n % box_size[d];
+          n /= box_size[d];
+        }
+      return i;
+    }
+
+
+
+    template <int dim>
+    dealii::Point<dim>
+    BackgroundGrid<dim>::node_position(const unsigned int n) const
+    {
+      const auto         i = lattice_index(n);
+      dealii::Point<dim> x = grid_lattice.origin;
+      for (unsigned int d = 0; d < dim; ++d)
+        x[d] += i[d] * grid_lattice.h;
+      return x;
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::exchange(const unsigned int first, const unsigned int n)
+    {
+      if (n_ranks == 1)
+        return;
+      // Ghost entries carry this rank's contributions (only the exchanged
+      // components are non-zero), owned shared entries this rank's own part;
+      // compress() adds the ghosts into their owners, update_ghost_values()
+      // returns the sums.
+      buffer.zero_out_ghost_values();
+      for (const auto &[box, l] : ghost_nodes)
+        for (unsigned int c = first; c < first + n; ++c)
+          buffer.local_element(l + c) = nodes[std::size_t(box) * n_comp + c];
+      for (const auto &[box, l] : import_nodes)
+        for (unsigned int c = first; c < first + n; ++c)
+          buffer.local_element(l + c) = nodes[std::size_t(box) * n_comp + c];
+      buffer.compress(dealii::VectorOperation::add);
+      buffer.update_ghost_values();
+      for (const auto &[box, l] : import_nodes)
+        for (unsigned int c = first; c < first + n; ++c)
+          nodes[std::size_t(box) * n_comp + c] = buffer.local_element(l + c);
+      for (const auto &[box, l] : ghost_nodes)
+        for (unsigned int c = first; c < first + n; ++c)
+          nodes[std::size_t(box) * n_comp + c] = buffer.local_element(l + c);
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::zero_interface(const unsigned int first, const unsigned int n)
+    {
+      for (const auto *list : {&ghost_nodes, &import_nodes})
+        for (const auto &entry : *list)
+          for (unsigned int c = first; c < first + n; ++c)
+            nodes[std::size_t(entry.first) * n_comp + c] = 0.0;
+    }
+
+
+
+    template class BackgroundGrid<2>;
+    template class BackgroundGrid<3>;
+  } // namespace MPM
+} // namespace hysteron

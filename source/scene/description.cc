@@ -1,0 +1,338 @@
+#include <deal.II/base/utilities.h>
+
+#include <hysteron/base/exceptions.h>
+#include <hysteron/scene/description.h>
+
+#include <cmath>
+
+namespace hysteron
+{
+  SceneNames
+  SceneNames::read(const dealii::ParameterHandler &prm)
+  {
+    SceneNames names;
+    names.materials  = parse_names(prm.get("Material names"), "Material names");
+    names.bodies     = parse_names(prm.get("Body names"), "Body names");
+    names.boundaries = parse_names(prm.get("Boundary names"), "Boundary names");
+    names.loads      = parse_names(prm.get("Load names"), "Load names");
+    return names;
+  }
+
+  namespace
+  {
+    const char *coordinate_names[3] = {"x", "y", "z"};
+
+    /// "x,y" or "x,y,z": the space variables of a function of position.
+    template <int dim>
+    std::string
+    space_variables()
+    {
+      return dim == 2 ? "x,y" : "x,y,z";
+    }
+  } // namespace
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  evaluate_in_time(const dealii::FunctionParser<1> &f, const double t)
+  {
+    dealii::Tensor<1, dim> v;
+    const dealii::Point<1> time(t);
+    for (unsigned int d = 0; d < dim; ++d)
+      v[d] = f.value(time, d);
+    return v;
+  }
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  BodyDescription<dim>::velocity_at(const dealii::Point<dim> &p) const
+  {
+    dealii::Tensor<1, dim> v;
+    if (initial_velocity)
+      for (unsigned int d = 0; d < dim; ++d)
+        v[d] = initial_velocity->value(p, d);
+    return v;
+  }
+
+  template <int dim>
+  std::string
+  BoundaryDescription<dim>::face_name(const unsigned int face)
+  {
+    return std::string(coordinate_names[face / 2]) + (face % 2 == 0 ? "-" : "+");
+  }
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  LoadDescription<dim>::value_at(const double t) const
+  {
+    return evaluate_in_time<dim>(*value, t);
+  }
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  parse_vector(const std::string &text, const std::string &where)
+  {
+    dealii::Tensor<1, dim> v;
+    if (dealii::Utilities::trim(text).empty())
+      return v;
+    const auto items = dealii::Utilities::split_string_list(text, ',');
+    require(items.size() == dim,
+            where,
+            "'" + text + "' has " + std::to_string(items.size()) + " components; a " +
+              std::to_string(dim) + "D scene needs " + std::to_string(dim));
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        try
+          {
+            v[d] = dealii::Utilities::string_to_double(items[d]);
+          }
+        catch (...)
+          {
+            throw InputError(where, "cannot read the number '" + items[d] + "'");
+          }
+        require(std::isfinite(v[d]), where, "'" + items[d] + "' is not finite");
+      }
+    return v;
+  }
+
+  void
+  declare_scene_descriptions(dealii::ParameterHandler &prm, const SceneNames &names)
+  {
+    using namespace dealii;
+    for (const auto &name : names.bodies)
+      {
+        prm.enter_subsection("Body " + name);
+        prm.declare_entry("Material",
+                          "",
+                          Patterns::Anything(),
+                          "Name of the body's material (one of `Material names`); empty: the "
+                          "default `subsection Material`.");
+        prm.declare_entry("Shape",
+                          "",
+                          Patterns::Anything(),
+                          "The body's region [m], e.g. 'rectangle(0, 0, 2, 0.1) - disk(1, 0.05, "
+                          "0.01)'; see doc/geometry.md. Required.");
+        prm.declare_entry("Particles per cell",
+                          "2",
+                          Patterns::Integer(1, 16),
+                          "MPM: material points per grid cell and direction (k^dim per cell).");
+        prm.declare_entry("Thickness",
+                          "1",
+                          Patterns::Double(),
+                          "2D: out-of-plane thickness [m], > 0 (plane strain: the length along "
+                          "z that the results refer to). Ignored in 3D.");
+        prm.declare_entry("Initial velocity",
+                          "",
+                          Patterns::Anything(),
+                          "Initial velocity [m/s] as functions of x, y (, z), components "
+                          "separated by ';', e.g. '0; -373'. Empty: at rest.");
+        prm.declare_entry("Rigid",
+                          "false",
+                          Patterns::Bool(),
+                          "A rigid body moves with the prescribed `Velocity` and imposes it on "
+                          "the grid nodes it touches; it has no stress (its material is unused).");
+        prm.declare_entry("Velocity",
+                          "",
+                          Patterns::Anything(),
+                          "Rigid bodies: velocity [m/s] as functions of t, components separated "
+                          "by ';', e.g. '0.01; 0' or '0.01*sin(2*pi*t); 0'.");
+        prm.leave_subsection();
+      }
+    for (const auto &name : names.boundaries)
+      {
+        prm.enter_subsection("Boundary " + name);
+        prm.declare_entry("Type",
+                          "fixed",
+                          Patterns::Selection("fixed|roller|wall|velocity"),
+                          "fixed: all velocity components zero; roller: the normal component "
+                          "zero (slip); wall: rigid frictionless wall, the body may slide and "
+                          "separate but not penetrate (normal velocity into the wall set to zero); "
+                          "velocity: the `Components` follow `Velocity`(t).");
+        prm.declare_entry("Faces",
+                          "",
+                          Patterns::Anything(),
+                          "Faces of the domain box the condition acts on: a list of x-, x+, y-, "
+                          "y+, z-, z+ (roller and wall need faces: the face gives the normal).");
+        prm.declare_entry("Region",
+                          "",
+                          Patterns::Anything(),
+                          "Alternatively (or additionally) the nodes inside this region [m] "
+                          "(fixed and velocity types); see doc/geometry.md.");
+        prm.declare_entry("Components",
+                          "all",
+                          Patterns::Anything(),
+                          "velocity type: the prescribed components, a list of x, y, z or 'all'.");
+        prm.declare_entry("Velocity",
+                          "",
+                          Patterns::Anything(),
+                          "velocity type: the velocity [m/s] as functions of t, one per space "
+                          "direction separated by ';' (entries of free components are unused).");
+        prm.leave_subsection();
+      }
+    for (const auto &name : names.loads)
+      {
+        prm.enter_subsection("Load " + name);
+        prm.declare_entry("Type",
+                          "force",
+                          Patterns::Selection("force|traction"),
+                          "force: `Value` is the total force [N], shared evenly by the points "
+                          "selected by `Region`; traction: `Value` is a force per unit area [Pa] "
+                          "on the selected points, which should be the body's outer layer.");
+        prm.declare_entry("Region",
+                          "",
+                          Patterns::Anything(),
+                          "The region whose material points (at t = 0) carry the load [m]; "
+                          "see doc/geometry.md. Required.");
+        prm.declare_entry("Value",
+                          "",
+                          Patterns::Anything(),
+                          "The load as functions of t, one component per space direction "
+                          "separated by ';', e.g. '0; -60e3*t/20'. Required.");
+        prm.leave_subsection();
+      }
+  }
+
+  template <int dim>
+  std::vector<BodyDescription<dim>>
+  parse_bodies(dealii::ParameterHandler &prm, const SceneNames &names)
+  {
+    std::vector<BodyDescription<dim>> bodies;
+    for (const auto &name : names.bodies)
+      {
+        Section             s(prm, {"Body " + name});
+        BodyDescription<dim> b;
+        b.name     = name;
+        b.material = dealii::Utilities::trim(s.get("Material"));
+        require(!dealii::Utilities::trim(s.get("Shape")).empty(),
+                s.where("Shape"),
+                "a body needs a shape, e.g. 'rectangle(0, 0, 1, 1)'");
+        b.shape              = Geometry::Region<dim>::parse(s.get("Shape"), s.where("Shape"));
+        b.particles_per_cell = s.get_integer("Particles per cell");
+        b.thickness          = s.get_positive("Thickness");
+        if (!dealii::Utilities::trim(s.get("Initial velocity")).empty())
+          b.initial_velocity = parse_vector_function<dim>(s.get("Initial velocity"),
+                                                          dim,
+                                                          space_variables<dim>(),
+                                                          false,
+                                                          s.where("Initial velocity"));
+        b.rigid = s.get_bool("Rigid");
+        if (b.rigid)
+          b.rigid_velocity =
+            parse_vector_function<1>(s.get("Velocity"), dim, "t", false, s.where("Velocity"));
+        else
+          require(dealii::Utilities::trim(s.get("Velocity")).empty(),
+                  s.where("Velocity"),
+                  "only rigid bodies have a prescribed velocity (set Rigid = true, or use "
+                  "`Initial velocity`)");
+        bodies.push_back(std::move(b));
+      }
+    return bodies;
+  }
+
+  template <int dim>
+  std::vector<BoundaryDescription<dim>>
+  parse_boundaries(dealii::ParameterHandler &prm, const SceneNames &names)
+  {
+    using Description = BoundaryDescription<dim>;
+    std::vector<Description> boundaries;
+    for (const auto &name : names.boundaries)
+      {
+        Section     s(prm, {"Boundary " + name});
+        Description b;
+        b.name                 = name;
+        const std::string type = s.get("Type");
+        b.type                 = type == "fixed"  ? Description::Type::fixed :
+                                 type == "roller" ? Description::Type::roller :
+                                 type == "wall"   ? Description::Type::wall :
+                                                    Description::Type::velocity;
+        for (const auto &f : s.get_list("Faces"))
+          {
+            bool found = false;
+            for (unsigned int face = 0; face < 2 * dim; ++face)
+              if (f == Description::face_name(face))
+                {
+                  b.faces.push_back(face);
+                  found = true;
+                }
+            require(found,
+                    s.where("Faces"),
+                    "unknown face '" + f + "' (a " + std::to_string(dim) + "D box has " +
+                      (dim == 2 ? "x-, x+, y-, y+" : "x-, x+, y-, y+, z-, z+") + ")");
+          }
+        b.has_region = !dealii::Utilities::trim(s.get("Region")).empty();
+        if (b.has_region)
+          b.region = Geometry::Region<dim>::parse(s.get("Region"), s.where("Region"));
+        require(!b.faces.empty() || b.has_region,
+                s.where("Faces"),
+                "a boundary condition needs `Faces` or a `Region`");
+        if (b.type == Description::Type::roller || b.type == Description::Type::wall)
+          require(!b.has_region && !b.faces.empty(),
+                  s.where("Region"),
+                  "roller and wall conditions act on `Faces` (the face gives the normal), "
+                  "not on a region");
+        b.components.assign(dim, true);
+        if (b.type == Description::Type::velocity)
+          {
+            const auto list = s.get_list("Components");
+            if (!(list.size() == 1 && list[0] == "all"))
+              {
+                b.components.assign(dim, false);
+                for (const auto &c : list)
+                  {
+                    bool found = false;
+                    for (unsigned int d = 0; d < dim; ++d)
+                      if (c == coordinate_names[d])
+                        b.components[d] = found = true;
+                    require(found,
+                            s.where("Components"),
+                            "unknown component '" + c + "' (use " +
+                              (dim == 2 ? "x, y" : "x, y, z") + " or all)");
+                  }
+              }
+            b.velocity =
+              parse_vector_function<1>(s.get("Velocity"), dim, "t", false, s.where("Velocity"));
+          }
+        boundaries.push_back(std::move(b));
+      }
+    return boundaries;
+  }
+
+  template <int dim>
+  std::vector<LoadDescription<dim>>
+  parse_loads(dealii::ParameterHandler &prm, const SceneNames &names)
+  {
+    std::vector<LoadDescription<dim>> loads;
+    for (const auto &name : names.loads)
+      {
+        Section              s(prm, {"Load " + name});
+        LoadDescription<dim> l;
+        l.name = name;
+        l.type = s.get("Type") == "force" ? LoadDescription<dim>::Type::force :
+                                            LoadDescription<dim>::Type::traction;
+        require(!dealii::Utilities::trim(s.get("Region")).empty(),
+                s.where("Region"),
+                "a load needs the region of the points it acts on");
+        l.region = Geometry::Region<dim>::parse(s.get("Region"), s.where("Region"));
+        l.value  = parse_vector_function<1>(s.get("Value"), dim, "t", false, s.where("Value"));
+        loads.push_back(std::move(l));
+      }
+    return loads;
+  }
+
+#define HYSTERON_INSTANTIATE(dim)                                                              \
+  template struct BodyDescription<dim>;                                                         \
+  template struct BoundaryDescription<dim>;                                                     \
+  template struct LoadDescription<dim>;                                                         \
+  template std::vector<BodyDescription<dim>> parse_bodies<dim>(dealii::ParameterHandler &,      \
+                                                               const SceneNames &);             \
+  template std::vector<BoundaryDescription<dim>> parse_boundaries<dim>(                         \
+    dealii::ParameterHandler &, const SceneNames &);                                            \
+  template std::vector<LoadDescription<dim>> parse_loads<dim>(dealii::ParameterHandler &,       \
+                                                              const SceneNames &);              \
+  template dealii::Tensor<1, dim> parse_vector<dim>(const std::string &, const std::string &);  \
+  template dealii::Tensor<1, dim> evaluate_in_time<dim>(const dealii::FunctionParser<1> &,      \
+                                                        double);
+
+  HYSTERON_INSTANTIATE(2)
+  HYSTERON_INSTANTIATE(3)
+#undef HYSTERON_INSTANTIATE
+} // namespace hysteron
