@@ -9,12 +9,16 @@ The scene runs in a fresh working directory (relative output paths land there) w
   # CHECK-COLUMNS <file>: <expr>  holds once, each column bound to the list of its values
   # EXPECT-ERROR: <regex>         the run must fail (exit status 1, or the one of EXIT),
                                   stderr must match <regex>, and no output file may be
-                                  left behind (no *.tmp, no CSV, no VTU)
+                                  left behind (no *.tmp, no CSV, no VTU; with EXIT: 2, a run
+                                  that failed, complete files of the last good state may stay)
   # EXIT: <n>                     the expected non-zero exit status (with EXPECT-ERROR)
   # EXPECT-STDERR: <regex>        stderr must match (e.g. a warning) on a successful run
   # EXPECT-STDOUT: <regex>        stdout must match on a successful run
   # ARGS: <arguments>             command line instead of "--quiet <prm>" ({prm} = the file)
   # MPI: 2                        also run on 2 ranks; every output file must be identical
+  # MPI-TOLERANCE: 1e-10[, 1e-14] with MPI: CSV values may differ by this fraction of the
+                                  largest magnitude in their column (sums in another order),
+                                  or by the optional absolute amount (columns of round-off)
 
 Expressions are Python over the CSV column names, with abs, sqrt, exp, log, tanh, sin, cos,
 pi, min, max, sum, len, all, any, and `i` (the row index) for CHECK.
@@ -40,7 +44,7 @@ SAFE = {
 def parse_directives(path):
     directives = []
     pattern = re.compile(r"^\s*#\s*(CHECK-LAST|CHECK-COLUMNS|CHECK|EXPECT-ERROR|EXPECT-STDERR|EXPECT-STDOUT|EXIT|"
-                         r"ARGS|MPI)\b\s*([^:]*):\s?(.*)$")
+                         r"ARGS|MPI-TOLERANCE|MPI)\b\s*([^:]*):\s?(.*)$")
     with open(path) as f:
         for line in f:
             m = pattern.match(line)
@@ -70,6 +74,25 @@ def output_files(directory):
         for name in files:
             found.append(os.path.relpath(os.path.join(root, name), directory))
     return sorted(found)
+
+
+def compare_csv(path_one, path_two, tolerance):
+    """None if the tables agree to tolerance[0] times each column's largest magnitude
+    (or to the absolute tolerance[1])."""
+    relative, absolute = tolerance
+    header1, one = read_csv(path_one)
+    header2, two = read_csv(path_two)
+    if header1 != header2:
+        return "the columns differ"
+    if len(one) != len(two):
+        return f"{len(two)} rows instead of {len(one)}"
+    for c, name in enumerate(header1):
+        scale = max([abs(r[c]) for r in one] + [1e-300])
+        for i, (a, b) in enumerate(zip(one, two)):
+            if abs(a[c] - b[c]) > max(relative * scale, absolute):
+                return (f"column {name}, row {i}: {a[c]!r} vs {b[c]!r} (more than {relative} of "
+                        f"the column's scale {scale:g} and more than {absolute})")
+    return None
 
 
 def main():
@@ -112,8 +135,11 @@ def main():
                 failures.append(f"stderr does not match /{regex}/")
         if "Traceback" in err or "terminate called" in err or "Aborted" in err:
             failures.append("the program crashed instead of reporting the error")
+        # Bad input (exit 1) writes nothing; a run that fails (exit 2) keeps its last good
+        # state, complete files only.
         left = [f for f in output_files(args.workdir)
-                if f != os.path.basename(prm) and not f.endswith("parameters.prm")]
+                if f != os.path.basename(prm) and not f.endswith("parameters.prm")
+                and (expected_code == 1 or f.endswith(".tmp"))]
         if left:
             failures.append(f"output files left behind after a failed run: {left}")
     else:
@@ -158,6 +184,11 @@ def main():
             except Exception as e:  # a broken expression is a failing test
                 failures.append(f"{kind} {target}: cannot evaluate {expr}: {e}")
 
+        tolerance = None
+        for k, _, v in directives:
+            if k == "MPI-TOLERANCE":
+                parts = [float(x) for x in v.split(",")]
+                tolerance = (parts[0], parts[1] if len(parts) > 1 else 0.0)
         for k, _, v in directives:
             if k != "MPI":
                 continue
@@ -177,6 +208,11 @@ def main():
             for f in comparable:
                 if f not in two:
                     failures.append(f"{ranks} ranks: {f} missing")
+                elif tolerance is not None:
+                    problem = compare_csv(os.path.join(args.workdir, f), os.path.join(mpi_dir, f),
+                                          tolerance)
+                    if problem:
+                        failures.append(f"{ranks} ranks: {f}: {problem}")
                 elif not filecmp.cmp(os.path.join(args.workdir, f), os.path.join(mpi_dir, f),
                                      shallow=False):
                     failures.append(f"{ranks} ranks: {f} differs from the 1-rank run")

@@ -105,6 +105,12 @@ namespace hysteron
                           Patterns::Double(),
                           "A fixed `Time/Time step` larger than this multiple of the critical "
                           "step h / max_p(c_p + |v_p|) (eq. 4.47) stops the run, > 0.");
+        prm.declare_entry("Write particle table",
+                          "false",
+                          Patterns::Bool(),
+                          "Write particles.csv at the end: one row per material point (id, body, "
+                          "position, displacement, velocity, stress, von Mises stress, strain, "
+                          "material state), sorted by id.");
         prm.declare_entry("Probe interval",
                           "0",
                           Patterns::Double(),
@@ -162,6 +168,7 @@ namespace hysteron
         jaumann        = s.get("Stress rate") == "Jaumann";
         maximum_cfl    = s.get_positive("Maximum CFL number");
         probe_interval = s.get_non_negative("Probe interval");
+        particle_table = s.get_bool("Write particle table");
       }
 
       // The scene's bodies must lie in the grid.
@@ -694,21 +701,8 @@ namespace hysteron
       for (unsigned int i = 0; i < probes.size(); ++i)
         {
           std::vector<std::string> columns{"time"};
-          for (const std::string prefix : {"x_", "u_", "v_"})
-            for (unsigned int d = 0; d < dim; ++d)
-              columns.push_back(prefix + component_suffix[d]);
-          for (const std::string prefix : {"s_", "eps_"})
-            {
-              for (unsigned int c = 0; c < PI::n_sym; ++c)
-                {
-                  const auto ij = dealii::SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
-                  columns.push_back(prefix + component_suffix[ij[0]] + component_suffix[ij[1]]);
-                }
-              if (prefix == "s_")
-                columns.push_back("von_mises");
-            }
-          for (const auto &name : state_names)
-            columns.push_back(name);
+          const auto               point = point_columns();
+          columns.insert(columns.end(), point.begin(), point.end());
           probe_tables.push_back(std::make_unique<Output::CsvWriter>(
             scene.output_file("probe_" + std::to_string(i) + ".csv"), columns));
         }
@@ -736,6 +730,103 @@ namespace hysteron
 
 
     template <int dim>
+    std::vector<std::string>
+    Solver<dim>::point_columns() const
+    {
+      using PI = PropertiesIndex<dim>;
+      std::vector<std::string> columns;
+      for (const std::string prefix : {"x_", "u_", "v_"})
+        for (unsigned int d = 0; d < dim; ++d)
+          columns.push_back(prefix + component_suffix[d]);
+      for (const std::string prefix : {"s_", "eps_"})
+        {
+          for (unsigned int c = 0; c < PI::n_sym; ++c)
+            {
+              const auto ij = dealii::SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
+              columns.push_back(prefix + component_suffix[ij[0]] + component_suffix[ij[1]]);
+            }
+          if (prefix == "s_")
+            columns.push_back("von_mises");
+        }
+      for (const auto &name : state_names)
+        columns.push_back(name);
+      return columns;
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::point_values(const unsigned int s, double *r) const
+    {
+      using namespace dealii;
+      using PI     = PropertiesIndex<dim>;
+      const auto  &P = particles;
+      unsigned int c = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        r[c++] = P.current.x[s][d];
+      for (unsigned int d = 0; d < dim; ++d)
+        r[c++] = P.current.x[s][d] - P.x0[s][d];
+      for (unsigned int d = 0; d < dim; ++d)
+        r[c++] = P.current.v[s][d];
+      const auto *group = &P.groups[0];
+      for (const auto &g : P.groups)
+        if (s >= g.begin && s < g.end)
+          group = &g;
+      const double *state = P.current.material_state.data() + group->state_offset +
+                            std::size_t(s - group->begin) * group->n_state;
+      for (unsigned int k = 0; k < PI::n_sym; ++k)
+        r[c++] = P.current.stress[s][SymmetricTensor<2, dim>::unrolled_to_component_indices(k)];
+      double sigma_zz = 0, eps_zz = 0;
+      if (dim == 2 && group->material != nullptr)
+        group->material->out_of_plane(P.current.strain[s], P.current.stress[s],
+                                      view(state, group->n_state), eps_zz, sigma_zz);
+      const double tr = dealii::trace(P.current.stress[s]) + sigma_zz;
+      r[c++] = std::sqrt(std::max(0.0, 1.5 * ((P.current.stress[s] * P.current.stress[s]) +
+                                               sigma_zz * sigma_zz - tr * tr / 3.0)));
+      for (unsigned int k = 0; k < PI::n_sym; ++k)
+        r[c++] = P.current.strain[s][SymmetricTensor<2, dim>::unrolled_to_component_indices(k)];
+      for (unsigned int k = 0; k < state_names.size(); ++k)
+        r[c++] = k < group->n_state ? state[k] : 0.0;
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::write_particle_table() const
+    {
+      const Scene<dim>  &scene   = this->get_scene();
+      const auto         columns = point_columns();
+      const unsigned int n       = columns.size() + 2;
+      std::vector<double> rows(particles.size() * n);
+      for (unsigned int s = 0; s < particles.size(); ++s)
+        {
+          rows[s * n]     = particles.id[s];
+          rows[s * n + 1] = particles.body[s];
+          point_values(s, rows.data() + s * n + 2);
+        }
+      std::vector<std::vector<double>> all{rows};
+      if (grid->is_parallel())
+        all = dealii::Utilities::MPI::gather(grid->mpi_communicator(), rows, 0);
+      if (!scene.is_root())
+        return;
+      std::vector<std::vector<double>> table;
+      for (const auto &part : all)
+        for (std::size_t i = 0; i < part.size(); i += n)
+          table.emplace_back(part.begin() + i, part.begin() + i + n);
+      std::sort(table.begin(), table.end());
+      std::vector<std::string> header{"id", "body"};
+      header.insert(header.end(), columns.begin(), columns.end());
+      Output::CsvWriter out(scene.output_file("particles.csv"), header);
+      for (const auto &row : table)
+        out.add_row(row);
+      out.commit();
+    }
+
+
+
+    template <int dim>
     void
     Solver<dim>::write_table_rows(const double t)
     {
@@ -746,40 +837,11 @@ namespace hysteron
       MPI_Comm          comm  = grid->mpi_communicator();
 
       // Probes: the owner fills its rows, the others contribute zeros.
-      const unsigned int  n_columns = 1 + 3 * dim + 2 * PI::n_sym + 1 + state_names.size();
+      const unsigned int  n_columns = 1 + point_columns().size();
       std::vector<double> rows(probes.size() * n_columns, 0.0);
       for (unsigned int i = 0; i < probes.size(); ++i)
         if (probes[i].local >= 0)
-          {
-            const unsigned int s = probes[i].local;
-            double            *r = rows.data() + i * n_columns;
-            unsigned int       c = 1;
-            for (unsigned int d = 0; d < dim; ++d)
-              r[c++] = P.current.x[s][d];
-            for (unsigned int d = 0; d < dim; ++d)
-              r[c++] = P.current.x[s][d] - P.x0[s][d];
-            for (unsigned int d = 0; d < dim; ++d)
-              r[c++] = P.current.v[s][d];
-            const auto *group = &P.groups[0];
-            for (const auto &g : P.groups)
-              if (s >= g.begin && s < g.end)
-                group = &g;
-            const double *state = P.current.material_state.data() + group->state_offset +
-                                  std::size_t(s - group->begin) * group->n_state;
-            for (unsigned int k = 0; k < PI::n_sym; ++k)
-              r[c++] = P.current.stress[s][SymmetricTensor<2, dim>::unrolled_to_component_indices(k)];
-            double sigma_zz = 0, eps_zz = 0;
-            if (dim == 2 && group->material != nullptr)
-              group->material->out_of_plane(P.current.strain[s], P.current.stress[s],
-                                            view(state, group->n_state), eps_zz, sigma_zz);
-            const double tr = dealii::trace(P.current.stress[s]) + sigma_zz;
-            r[c++] = std::sqrt(std::max(0.0, 1.5 * ((P.current.stress[s] * P.current.stress[s]) +
-                                                     sigma_zz * sigma_zz - tr * tr / 3.0)));
-            for (unsigned int k = 0; k < PI::n_sym; ++k)
-              r[c++] = P.current.strain[s][SymmetricTensor<2, dim>::unrolled_to_component_indices(k)];
-            for (unsigned int k = 0; k < state_names.size(); ++k)
-              r[c++] = k < group->n_state ? state[k] : 0.0;
-          }
+          point_values(probes[i].local, rows.data() + i * n_columns + 1);
 
       // Energies of this rank's points: kinetic and elastic strain energy
       // w = ((1 + nu) sigma : sigma - nu tr(sigma)^2) / (2 E) (with sigma_zz in 2D).
@@ -1049,6 +1111,8 @@ namespace hysteron
         }
       progress.finish(n_steps, t);
       commit_tables();
+      if (particle_table)
+        write_particle_table();
     }
 
 

@@ -12,6 +12,7 @@
 
 #include <dlfcn.h>
 #include <filesystem>
+#include <memory>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -107,8 +108,18 @@ namespace hysteron
     void
     run_scene(dealii::ParameterHandler &prm, const RunOptions &options)
     {
-      Scene<dim> scene(prm, options);
-      scene.run();
+      auto scene = std::make_unique<Scene<dim>>(prm, options);
+      try
+        {
+          scene->run();
+        }
+      catch (...)
+        {
+          // Destroy the scene (and its TimerOutput) while the exception is
+          // caught: every rank fails together, so its clean-up may communicate.
+          scene.reset();
+          throw;
+        }
     }
 
     int

@@ -104,6 +104,7 @@ namespace hysteron
       bool                          jaumann       = false;
       double                        maximum_cfl   = 1.0;
       double                        probe_interval = 0.0;
+      bool                          particle_table = false;
       double                        small_mass = 0; ///< nodes lighter than this have no velocity
 
       // Set-up and the pieces of run().
@@ -127,6 +128,13 @@ namespace hysteron
       write_fields(const double t);
       void
       open_tables();
+      /// Column names and values of one point (probes, particle table).
+      std::vector<std::string>
+      point_columns() const;
+      void
+      point_values(const unsigned int s, double *values) const;
+      void
+      write_particle_table() const;
       void
       write_table_rows(const double t);
       void
