@@ -16,7 +16,7 @@ halving of h (Table 4-1: 4.6x and 4.1x); with linear shape functions more points
 not help (Table 4-2's trend: in the interior, 4x4 points per cell are less accurate than 1,
 which sits at the cell centre where the piecewise-constant gradient is superconvergent).
 
-Usage: velocity_gradient.py HYSTERON WORKDIR [--markdown FILE]
+Usage: velocity_gradient.py HYSTERON WORKDIR [--markdown FILE] [--plot FILE.png]
 """
 import csv
 import math
@@ -85,6 +85,7 @@ def run_case(hysteron, workdir, n, k, basis):
 def main():
     hysteron, workdir = sys.argv[1], sys.argv[2]
     markdown = sys.argv[sys.argv.index("--markdown") + 1] if "--markdown" in sys.argv else None
+    plot = sys.argv[sys.argv.index("--plot") + 1] if "--plot" in sys.argv else None
     results = {}
     for basis in ("cubic B-spline", "linear"):
         for n in (10, 20, 40):
@@ -98,6 +99,28 @@ def main():
     if markdown:
         with open(markdown, "w") as f:
             f.write("\n".join(lines) + "\n")
+
+    if plot:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+        for ax, which, title in ((axes[0], 0, "interior points (1 <= x <= 4)"),
+                                 (axes[1], 1, "all points")):
+            for basis, style in (("cubic B-spline", "-"), ("linear", "--")):
+                for k, marker in ((1, "o"), (2, "s"), (4, "^")):
+                    hs = [5.0 / n for n in (10, 20, 40)]
+                    errors = [results[(basis, n, k)][which] for n in (10, 20, 40)]
+                    ax.loglog(hs, errors, style + marker, label=f"{basis}, {k}x{k} per cell")
+            ax.loglog([0.125, 0.5], [1.0e-5, 1.6e-4], "k:", label="slope 2")
+            ax.set_xlabel("cell size h [m]")
+            ax.set_ylabel("RMS error of L_p [1/s]")
+            ax.set_title(title)
+            ax.grid(True, which="both", alpha=0.3)
+        axes[0].legend(fontsize=7)
+        fig.suptitle("MPM velocity gradient, dissertation §4.6.1")
+        fig.tight_layout()
+        fig.savefig(plot, dpi=110)
 
     failures = []
     for k in (1, 2):

@@ -28,7 +28,7 @@ namespace hysteron
         double                        g[dim][n1];
         unsigned int                  base;
 
-        inline void
+        DEAL_II_ALWAYS_INLINE inline void
         reinit(const Lattice<dim>        &lattice,
                const BackgroundGrid<dim> &grid,
                const dealii::Point<dim>  &x,
@@ -51,7 +51,7 @@ namespace hysteron
 
         /// Call f(node, N, grad N) for every support node.
         template <typename Function>
-        inline void
+        DEAL_II_ALWAYS_INLINE inline void
         for_each(const unsigned int s1, const unsigned int s2, const Function &f) const
         {
           dealii::Tensor<1, dim> grad;
