@@ -347,21 +347,16 @@ namespace hysteron
       const unsigned int n    = handler->n_locally_owned_particles();
       const Lattice<dim> &lattice = grid->lattice();
 
-      // Read in the handler's order.
-      std::vector<Point<dim>>            x(n);
+      // First pass: the sort key of every point (handler order): group, cell, id.
       std::vector<types::particle_index> ids(n);
-      std::vector<double>                props(std::size_t(n) * n_properties);
       std::vector<unsigned int>          key(n), cells(n);
       {
         unsigned int k = 0;
         for (const auto &particle : *handler)
           {
-            x[k]             = particle.get_location();
-            ids[k]           = particle.get_id();
-            const auto source = particle.get_properties();
-            std::copy(source.begin(), source.end(), props.begin() + std::size_t(k) * n_properties);
-            key[k]   = group_of_body[static_cast<unsigned int>(props[std::size_t(k) * n_properties + PI::body])];
-            cells[k] = grid->cell_id(lattice.cell_of(x[k]));
+            ids[k]   = particle.get_id();
+            key[k]   = group_of_body[static_cast<unsigned int>(particle.get_properties()[PI::body])];
+            cells[k] = grid->cell_id(lattice.cell_of(particle.get_location()));
             ++k;
           }
       }
@@ -404,52 +399,60 @@ namespace hysteron
       P.handler_index.resize(n);
       P.current.resize(n, n_state_total);
       P.next.resize(n, n_state_total);
-      strain_increment.resize(n);
 
-      for (const auto &group : P.groups)
-        for (unsigned int s = group.begin; s < group.end; ++s)
-          {
-            const unsigned int k = order[s];
-            const double      *q = props.data() + std::size_t(k) * n_properties;
-            P.handler_index[s]   = k;
-            P.id[s]              = ids[k];
-            P.body[s]            = static_cast<unsigned int>(q[PI::body]);
-            P.load[s]            = static_cast<unsigned int>(q[PI::load]);
-            P.mass[s]            = q[PI::mass];
-            P.volume0[s]         = q[PI::volume0];
-            P.thickness[s]       = q[PI::thickness];
-            P.cell[s]            = cells[k];
-            P.current.x[s]       = x[k];
-            P.current.volume[s]  = q[PI::volume];
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                P.current.v[s][d] = q[PI::velocity + d];
-                P.x0[s][d]        = x[k][d] - q[PI::displacement + d];
-                for (unsigned int e = 0; e < dim; ++e)
-                  P.current.F[s][d][e] = q[PI::deformation_gradient + d * dim + e];
-              }
-            for (unsigned int c = 0; c < PI::n_sym; ++c)
-              {
-                const auto ij = SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
-                P.current.stress[s][ij] = q[PI::stress + c];
-                P.current.strain[s][ij] = q[PI::strain + c];
-              }
-            std::copy(q + PI::n_fixed,
-                      q + PI::n_fixed + group.n_state,
-                      P.current.material_state.begin() + group.state_offset +
-                        std::size_t(s - group.begin) * group.n_state);
-            // Load share: a total force is split evenly; a traction acts on the
-            // point's face, of area V / l_p with l_p = (V / thickness)^(1/dim).
-            P.load_factor[s] = 0;
-            if (P.load[s] > 0)
-              {
-                if (loads[P.load[s] - 1].type == LoadDescription<dim>::Type::force)
-                  P.load_factor[s] = 1.0 / load_count[P.load[s]];
-                else
-                  P.load_factor[s] =
-                    P.volume0[s] / std::pow(P.volume0[s] / P.thickness[s], 1.0 / dim);
-              }
-          }
+      // Second pass (same order): copy every point straight to its place.
+      std::vector<unsigned int> place(n), group_of(n);
+      for (unsigned int s = 0; s < n; ++s)
+        place[order[s]] = s;
+      for (unsigned int g = 0; g < P.groups.size(); ++g)
+        for (unsigned int s = P.groups[g].begin; s < P.groups[g].end; ++s)
+          group_of[s] = g;
+      unsigned int k = 0;
+      for (const auto &particle : *handler)
+        {
+          const unsigned int s     = place[k];
+          const auto        &group = P.groups[group_of[s]];
+          const auto         q     = particle.get_properties();
+          const Point<dim>   x     = particle.get_location();
+          P.handler_index[s]       = k;
+          P.id[s]                  = ids[k];
+          P.cell[s]                = cells[k];
+          ++k;
+          P.body[s]           = static_cast<unsigned int>(q[PI::body]);
+          P.load[s]           = static_cast<unsigned int>(q[PI::load]);
+          P.mass[s]           = q[PI::mass];
+          P.volume0[s]        = q[PI::volume0];
+          P.thickness[s]      = q[PI::thickness];
+          P.current.x[s]      = x;
+          P.current.volume[s] = q[PI::volume];
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              P.current.v[s][d] = q[PI::velocity + d];
+              P.x0[s][d]        = x[d] - q[PI::displacement + d];
+              for (unsigned int e = 0; e < dim; ++e)
+                P.current.F[s][d][e] = q[PI::deformation_gradient + d * dim + e];
+            }
+          for (unsigned int c = 0; c < PI::n_sym; ++c)
+            {
+              const auto ij = SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
+              P.current.stress[s][ij] = q[PI::stress + c];
+              P.current.strain[s][ij] = q[PI::strain + c];
+            }
+          std::copy(q.begin() + PI::n_fixed,
+                    q.begin() + PI::n_fixed + group.n_state,
+                    P.current.material_state.begin() + group.state_offset +
+                      std::size_t(s - group.begin) * group.n_state);
+          // Load share: a total force is split evenly; a traction acts on the
+          // point's face, of area V / l_p with l_p = (V / thickness)^(1/dim).
+          P.load_factor[s] = 0;
+          if (P.load[s] > 0)
+            {
+              if (loads[P.load[s] - 1].type == LoadDescription<dim>::Type::force)
+                P.load_factor[s] = 1.0 / load_count[P.load[s]];
+              else
+                P.load_factor[s] = P.volume0[s] / std::pow(P.volume0[s] / P.thickness[s], 1.0 / dim);
+            }
+        }
 
       for (auto &probe : probes)
         probe.local = -1;

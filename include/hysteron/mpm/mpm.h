@@ -199,8 +199,10 @@ namespace hysteron
       std::vector<unsigned int> rigid_nodes;
       unsigned int              stamp = 0;
 
-      // Per step scratch.
-      std::vector<dealii::SymmetricTensor<2, dim>> strain_increment;
+      // Per step scratch: the strain increments of one chunk of points.
+      static constexpr unsigned int                stress_chunk = 256;
+      std::vector<dealii::SymmetricTensor<2, dim>> strain_increment =
+        std::vector<dealii::SymmetricTensor<2, dim>>(stress_chunk);
 
       // Diagnostics of the last step.
       double       max_speed            = 0; ///< max_p (c_p + |v_p|)

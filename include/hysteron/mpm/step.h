@@ -374,58 +374,66 @@ namespace hysteron
                 }
               continue;
             }
+          // Chunks of points: strain increments of a chunk, then one material
+          // call for the chunk (the scratch stays in cache).
           Support support;
-          for (unsigned int p = begin; p < end; ++p)
+          for (unsigned int chunk = begin; chunk < end; chunk += stress_chunk)
             {
-              support.reinit(lattice, *grid, cur.x[p], inv_h);
-              Tensor<2, dim> L; // velocity gradient sum_i v_i (x) grad N_i
-              support.for_each(s1, s2, [&](const unsigned int n, double, const Tensor<1, dim> &grad) {
-                const double *const r = node + std::size_t(n) * C;
-                for (unsigned int i = 0; i < dim; ++i)
-                  for (unsigned int j = 0; j < dim; ++j)
-                    L[i][j] += r[1 + i] * grad[j];
-              });
-              const SymmetricTensor<2, dim> de = symmetrize(L) * dt;
-              strain_increment[p]              = de;
-              nxt.strain[p]                    = cur.strain[p] + de;
-              nxt.F[p]                         = (identity + dt * L) * cur.F[p];
-              nxt.volume[p]                    = determinant(nxt.F[p]) * particles.volume0[p];
-              if (jaumann)
+              const unsigned int chunk_end = std::min(end, chunk + stress_chunk);
+              for (unsigned int p = chunk; p < chunk_end; ++p)
                 {
-                  // Jaumann rate: sigma' = C : d + W sigma - sigma W with the spin
-                  // W = skew(L); W sigma - sigma W is symmetric for symmetric sigma.
-                  const Tensor<2, dim> W     = 0.5 * dt * (L - transpose(L));
-                  const Tensor<2, dim> s     = cur.stress[p];
-                  nxt.stress[p]              = symmetrize(W * s - s * W) + cur.stress[p];
+                  support.reinit(lattice, *grid, cur.x[p], inv_h);
+                  Tensor<2, dim> L; // velocity gradient sum_i v_i (x) grad N_i
+                  support.for_each(s1, s2, [&](const unsigned int n, double, const Tensor<1, dim> &grad) {
+                    const double *const r = node + std::size_t(n) * C;
+                    for (unsigned int i = 0; i < dim; ++i)
+                      for (unsigned int j = 0; j < dim; ++j)
+                        L[i][j] += r[1 + i] * grad[j];
+                  });
+                  const SymmetricTensor<2, dim> de = symmetrize(L) * dt;
+                  strain_increment[p - chunk]      = de;
+                  nxt.strain[p]                    = cur.strain[p] + de;
+                  nxt.F[p]                         = (identity + dt * L) * cur.F[p];
+                  nxt.volume[p]                    = determinant(nxt.F[p]) * particles.volume0[p];
+                  if (jaumann)
+                    {
+                      // Jaumann rate: sigma' = C : d + W sigma - sigma W with the spin
+                      // W = skew(L); W sigma - sigma W is symmetric for symmetric sigma.
+                      const Tensor<2, dim> W = 0.5 * dt * (L - transpose(L));
+                      const Tensor<2, dim> s = cur.stress[p];
+                      nxt.stress[p]          = symmetrize(W * s - s * W) + cur.stress[p];
+                    }
+                  else
+                    nxt.stress[p] = cur.stress[p];
                 }
-              else
-                nxt.stress[p] = cur.stress[p];
+              const unsigned int n_points = chunk_end - chunk;
+              const std::size_t  offset   = group.state_offset + std::size_t(chunk - begin) * group.n_state;
+              const std::size_t  n_state  = std::size_t(n_points) * group.n_state;
+              if (n_state > 0)
+                std::memcpy(nxt.material_state.data() + offset,
+                            cur.material_state.data() + offset,
+                            n_state * sizeof(double));
+              group.material->update(view(strain_increment.data(), n_points),
+                                     view(nxt.stress.data() + chunk, n_points),
+                                     view(nxt.material_state.data() + offset, n_state),
+                                     ArrayView<SymmetricTensor<4, dim>>());
+              // Stress power, trapezoidal in time: dW = V sigma_mid : d eps.
+              double work = 0;
+              for (unsigned int p = chunk; p < chunk_end; ++p)
+                work += 0.25 * (cur.volume[p] + nxt.volume[p]) *
+                        ((cur.stress[p] + nxt.stress[p]) * strain_increment[p - chunk]);
+              if (!std::isfinite(work))
+                {
+                  for (unsigned int p = chunk; p < chunk_end && failed_point < 0; ++p)
+                    if (!std::isfinite(nxt.stress[p].norm()) || !std::isfinite(nxt.volume[p]))
+                      {
+                        failed_point = p;
+                        failure      = "a non-finite stress";
+                      }
+                  return;
+                }
+              internal_work += work;
             }
-          const std::size_t n_state = std::size_t(end - begin) * group.n_state;
-          if (n_state > 0)
-            std::memcpy(nxt.material_state.data() + group.state_offset,
-                        cur.material_state.data() + group.state_offset,
-                        n_state * sizeof(double));
-          group.material->update(view(strain_increment.data() + begin, end - begin),
-                                 view(nxt.stress.data() + begin, end - begin),
-                                 view(nxt.material_state.data() + group.state_offset, n_state),
-                                 ArrayView<SymmetricTensor<4, dim>>());
-          // Stress power, trapezoidal in time: dW = V sigma_mid : d eps.
-          double work = 0;
-          for (unsigned int p = begin; p < end; ++p)
-            work += 0.25 * (cur.volume[p] + nxt.volume[p]) *
-                    ((cur.stress[p] + nxt.stress[p]) * strain_increment[p]);
-          if (!std::isfinite(work))
-            {
-              for (unsigned int p = begin; p < end && failed_point < 0; ++p)
-                if (!std::isfinite(nxt.stress[p].norm()) || !std::isfinite(nxt.volume[p]))
-                  {
-                    failed_point = p;
-                    failure      = "a non-finite stress";
-                  }
-              return;
-            }
-          internal_work += work;
         }
     }
   } // namespace MPM
