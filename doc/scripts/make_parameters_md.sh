@@ -13,6 +13,8 @@ the file is read, and a rejected value is reported with its full path, e.g.
 `hysteron: error: Material/Young's modulus: must be > 0 (got -1)`.
 
 Named materials: for every name N in `Material names` there is a `subsection Material N` with the
-same entries as `subsection Material` (not repeated below).
+same entries as `subsection Material` (not repeated below). Likewise every name N in `Body names`,
+`Boundary names` and `Load names` gets a `subsection Body N`, `Boundary N`, `Load N` with the
+entries listed below under `Body <name>`, `Boundary <name>` and `Load <name>`.
 HEADER
 "$exe" --print-parameters markdown

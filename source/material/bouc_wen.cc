@@ -474,10 +474,34 @@ namespace hysteron
             return;
           }
 
+        std::size_t p = 0;
+        if constexpr (integrator == BoucWenIntegrator::adaptive)
+          if (!want_tangent)
+            {
+              // Interleaved first attempts (Law::adaptive_points()); no tangent, so
+              // only the end state's H1 and H2 are needed.
+              constexpr unsigned int n_points = 4;
+              typename L::VecN       y[n_points];
+              typename L::VecK       deps[n_points];
+              typename L::Rates      r[n_points];
+              for (; p + n_points <= strain_increments.size(); p += n_points)
+                {
+                  double *st = states.data() + p * size;
+                  for (unsigned int k = 0; k < n_points; ++k)
+                    {
+                      P::load(stresses[p + k], st + k * size, y[k]);
+                      P::strain(strain_increments[p + k], deps[k]);
+                    }
+                  L::template adaptive_points<n_points>(c, y, deps, r);
+                  for (unsigned int k = 0; k < n_points; ++k)
+                    P::store(c, y[k], r[k].H1, r[k].H2, stresses[p + k], st + k * size);
+                }
+            }
+
         typename L::VecN y;
         typename L::VecK deps;
         typename L::MatK T;
-        for (std::size_t p = 0; p < strain_increments.size(); ++p)
+        for (; p < strain_increments.size(); ++p)
           {
             double *st = states.data() + p * size;
             P::load(stresses[p], st, y);
@@ -543,6 +567,9 @@ namespace hysteron
       c.n            = parameters.smoothness;
       c.n_integer =
         (c.n == std::floor(c.n) && c.n >= 1 && c.n <= 1024) ? static_cast<unsigned int>(c.n) : 0;
+      c.n_half       = c.n_integer % 2 == 0 ? c.n_integer / 2 : 0;
+      c.radial_g     = 2.25 / (c.H + 1.5 * c.two_mu);
+      c.H_3mu        = c.H + 1.5 * c.two_mu;
       c.beta         = parameters.beta;
       c.gamma        = parameters.gamma;
       c.c_eta        = parameters.stiffness_degradation_c_eta;

@@ -27,7 +27,8 @@ namespace hysteron
     BackgroundGrid<dim>::initialize(const dealii::Point<dim>            &lower,
                                     const double                          h,
                                     const std::array<unsigned int, dim> &n_cells,
-                                    const unsigned int                    n_components)
+                                    const unsigned int                    n_components,
+                                    const std::vector<unsigned int>      &work_per_cell)
     {
       using namespace dealii;
       grid_lattice.origin  = lower;
@@ -44,6 +45,21 @@ namespace hysteron
           n_lattice_cells *= n_cells[d];
         }
       GridGenerator::subdivided_hyper_rectangle(tria, repetitions, lower, upper);
+      if (n_ranks > 1 && !work_per_cell.empty())
+        {
+          // p4est adds up these weights along its space-filling curve; a cell
+          // without points still costs a little (its share of the grid).
+          auto connection = tria.signals.weight.connect(
+            [&](const typename Triangulation<dim>::cell_iterator &cell,
+                const typename Triangulation<dim>::CellStatus) -> unsigned int {
+              std::array<unsigned int, dim> c;
+              for (unsigned int d = 0; d < dim; ++d)
+                c[d] = static_cast<unsigned int>(std::floor((cell->center()[d] - lower[d]) / h));
+              return 1000u * work_per_cell[cell_id(c)];
+            });
+          tria.repartition();
+          connection.disconnect();
+        }
 
       fe = std::make_unique<FESystem<dim>>(FE_Q<dim>(1), n_comp);
       dof_handler.reinit(tria);

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <sstream>
 
@@ -178,15 +179,36 @@ namespace hysteron
       for (const auto &body : bodies)
         {
           deformable = deformable || !body.rigid;
+          // A body whose bounding box leaves the grid is checked exactly: fill the
+          // ring of cells just outside the grid; a point there means the grid
+          // would cut the body (a quarter cylinder written as box - (all - cylinder)
+          // has a larger bounding box but no point outside).
           const auto box = body.shape.bounding_box();
           for (unsigned int d = 0; d < dim; ++d)
-            require(box.lower_bound(d) >= lower[d] - 1e-12 * cell_size &&
-                      box.upper_bound(d) <= upper[d] + 1e-12 * cell_size,
-                    "Body " + body.name + "/Shape",
-                    std::string("the body reaches outside the grid in ") + component_suffix[d] +
-                      " (body from " + std::to_string(box.lower_bound(d)) + " to " +
-                      std::to_string(box.upper_bound(d)) + ", grid from " +
-                      std::to_string(lower[d]) + " to " + std::to_string(upper[d]) + ")");
+            if (box.lower_bound(d) < lower[d] - 1e-12 * cell_size ||
+                box.upper_bound(d) > upper[d] + 1e-12 * cell_size)
+              {
+                Geometry::FillLattice<dim> ring{lower, cell_size, n_cells};
+                for (unsigned int e = 0; e < dim; ++e)
+                  {
+                    ring.origin[e] -= cell_size;
+                    ring.n_cells[e] += 2;
+                  }
+                const auto outside = Geometry::fill<dim>(
+                  body.shape, ring, body.particles_per_cell,
+                  [&](const std::array<unsigned int, dim> &c) {
+                    for (unsigned int e = 0; e < dim; ++e)
+                      if (c[e] == 0 || c[e] == ring.n_cells[e] - 1)
+                        return true;
+                    return false;
+                  });
+                require(outside.empty(),
+                        "Body " + body.name + "/Shape",
+                        std::string("the body reaches outside the grid in ") + component_suffix[d] +
+                          " (body from " + std::to_string(box.lower_bound(d)) + " to " +
+                          std::to_string(box.upper_bound(d)) + ", grid from " +
+                          std::to_string(lower[d]) + " to " + std::to_string(upper[d]) + ")");
+              }
         }
       require(deformable, "Body names", "the mpm method needs at least one body that is not rigid");
     }
@@ -198,8 +220,32 @@ namespace hysteron
     Solver<dim>::setup_grid()
     {
       const Scene<dim> &scene = this->get_scene();
+      // Fill the bodies first (every rank, same order): the points per cell
+      // weigh the cells when p4est partitions them, so that ranks get equal work.
+      Lattice<dim> lattice;
+      lattice.origin  = lower;
+      lattice.h       = cell_size;
+      lattice.n_cells = n_cells;
+      const Geometry::FillLattice<dim> fill_lattice{lower, cell_size, n_cells};
+      std::vector<unsigned int>        points_per_cell;
+      if (dealii::Utilities::MPI::n_mpi_processes(scene.mpi_communicator()) > 1)
+        points_per_cell.assign(std::accumulate(n_cells.begin(), n_cells.end(), 1u, std::multiplies<>()), 0);
+      body_points.clear();
+      for (const auto &body : scene.body_descriptions())
+        {
+          body_points.push_back(Geometry::fill(body.shape, fill_lattice, body.particles_per_cell));
+          if (!points_per_cell.empty())
+            for (const auto &x : body_points.back())
+              {
+                const auto         c  = lattice.cell_of(x);
+                unsigned int       id = 0;
+                for (int d = dim - 1; d >= 0; --d)
+                  id = id * n_cells[d] + c[d];
+                ++points_per_cell[id];
+              }
+        }
       grid = std::make_unique<BackgroundGrid<dim>>(scene.mpi_communicator());
-      grid->initialize(lower, cell_size, n_cells, 1 + 2 * dim);
+      grid->initialize(lower, cell_size, n_cells, 1 + 2 * dim, points_per_cell);
       node_stamp.assign(grid->n_local_nodes(), 0);
       rigid_node_body.assign(grid->n_local_nodes(), 0);
       active_nodes.clear();
@@ -255,8 +301,7 @@ namespace hysteron
 
       // Every rank generates all points in the same order (so the ids, load
       // counts and probe points agree) and keeps those in its own cells.
-      const Lattice<dim>       &lattice = grid->lattice();
-      Geometry::FillLattice<dim> fill_lattice{lattice.origin, lattice.h, lattice.n_cells};
+      const Lattice<dim> &lattice = grid->lattice();
       load_count.assign(loads.size() + 1, 0);
       std::vector<double>    properties(n_properties);
       types::particle_index  next_id = 0;
@@ -264,7 +309,7 @@ namespace hysteron
       for (unsigned int b = 0; b < bodies.size(); ++b)
         {
           const auto &body   = bodies[b];
-          const auto  points = Geometry::fill(body.shape, fill_lattice, body.particles_per_cell);
+          const auto &points = body_points[b];
           require(!points.empty(),
                   "Body " + body.name + "/Shape",
                   "the body holds no material point (points sit at the centres of the " +
@@ -325,6 +370,8 @@ namespace hysteron
             }
         }
       n_global_particles = next_id;
+      body_points.clear();
+      body_points.shrink_to_fit();
       handler->update_cached_numbers();
       for (unsigned int l = 1; l < load_count.size(); ++l)
         require(load_count[l] > 0,
@@ -1085,10 +1132,11 @@ namespace hysteron
 
           // Points that left this rank's cells go to their new owner; many cell
           // changes restore the cell order of the arrays (locality).
-          bool migrate = left_subdomain;
+          // (sorting is collective: every rank decides the same)
+          bool rebuild = left_subdomain || n_changed_cells > particles.size() / 4 + 16;
           if (grid->is_parallel())
-            migrate = dealii::Utilities::MPI::logical_or(migrate, grid->mpi_communicator());
-          if (migrate || n_changed_cells > particles.size() / 4 + 16)
+            rebuild = dealii::Utilities::MPI::logical_or(rebuild, grid->mpi_communicator());
+          if (rebuild)
             {
               dealii::TimerOutput::Scope timing(scene.timer(), "sort and migrate");
               to_handler();

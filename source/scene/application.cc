@@ -178,6 +178,13 @@ namespace hysteron
         }
       else if (!print_parameters)
         throw InputError("command line", "no parameter file given\n" + std::string(usage_text));
+      else
+        {
+          // Without a scene, document one instance of each named subsection.
+          preamble.names.bodies     = {"<name>"};
+          preamble.names.boundaries = {"<name>"};
+          preamble.names.loads      = {"<name>"};
+        }
 
       dealii::ParameterHandler prm;
       if (preamble.dimension == 2)

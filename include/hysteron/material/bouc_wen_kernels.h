@@ -120,7 +120,11 @@ namespace hysteron
      *   nu_s H1 <= 1 (exact solutions do), which an explicit method near its stability
      *   limit on the stiff relaxation towards q = sigma_y otherwise misses by a few
      *   tolerances for large n. Tangent: E_t at the end state (sign of the current
-     *   increment).
+     *   increment). The stages use stage_rates() (q^2 form, no n or lambda1); the
+     *   drift correction without degradation starts from the last stage
+     *   (drift_correction_stage()). Without a tangent, BoucWen::update() runs the
+     *   first attempt of four points stage by stage together (adaptive_points()),
+     *   which overlaps their dependency chains.
      * - backward Euler: rates at the end of the increment, H2 frozen from the
      *   trial direction sgn(n_tr : D : deps), n_tr at sigma0 + D deps/eta0 - alpha0
      *   (in 3D / plane strain without degradation n_tr is exactly the end-state
@@ -153,6 +157,9 @@ namespace hysteron
         double       inv_sigma_y0 = 1, inv_eps_y = 1, inv_energy = 1;
         unsigned int max_substeps   = 100000;
         unsigned int max_iterations = 50;
+        unsigned int n_half         = 0; ///< n / 2 if n is an even integer in [2, 1024], else 0
+        double       radial_g       = 0; ///< 9/4 / (H' + 3 mu) (stage_rates(), 3D/plane strain)
+        double       H_3mu          = 0; ///< H' + 3 mu
       };
 
       template <StressState S>
@@ -275,6 +282,43 @@ namespace hysteron
         return c.n_integer == 0 ? std::pow(x, c.n) : integer_power(x, c.n_integer);
       }
 
+      /// t^m and t^(m - 1) for an integer m >= 1 (the H1 = t^(n/2) of stage_rates() and
+      /// H1 / q^2 = t^(n/2 - 1) / sigma_y^2), sharing the squarings for m = 2, 4, 8, 16.
+      inline double
+      power_pair(const double t, const unsigned int m, double &t_m1)
+      {
+        switch (m)
+          {
+            case 1:
+              t_m1 = 1;
+              return t;
+            case 2:
+              t_m1 = t;
+              return t * t;
+            case 4:
+              {
+                const double t2 = t * t;
+                t_m1            = t2 * t;
+                return t2 * t2;
+              }
+            case 8:
+              {
+                const double t2 = t * t, t4 = t2 * t2;
+                t_m1 = t4 * (t2 * t);
+                return t4 * t4;
+              }
+            case 16:
+              {
+                const double t2 = t * t, t4 = t2 * t2, t8 = t4 * t4;
+                t_m1 = t8 * (t4 * (t2 * t));
+                return t8 * t8;
+              }
+            default:
+              t_m1 = integer_power(t, m - 1);
+              return t_m1 * t;
+          }
+      }
+
       inline double
       sign(const double x)
       {
@@ -394,6 +438,15 @@ namespace hysteron
           double q = 0, sigma_y = 1, H1 = 0, H2 = 0, lambda1 = 0, eta = 1, nu = 1;
         };
 
+        /// What stage_rates() knows about its state besides the rates.
+        struct Stage
+        {
+          VecF   d;  ///< dev(sigma - alpha)
+          VecK   Dd; ///< D d (K components)
+          double q2 = 0, q = 0, sigma_y = 1, H1 = 0, H2 = 0, eta = 1, nu = 1;
+          double dDe = 0, dDd = 0; ///< d:D:deps, d:D:d (plane stress or degradation)
+        };
+
         /// dy = f(y) for the strain increment deps (De = D deps).
         static void
         rates(const Constants &c, const double *y, const VecK &De, double *dy, Rates &r)
@@ -453,73 +506,116 @@ namespace hysteron
         }
 
         /**
-         * dy = f(y) as rates(), for the inner stages of adaptive(): the rates only
-         * (no Rates filled), in the q^2 form of FusedForwardEuler. With
-         * d = dev(xi), q^2 = 3/2 d:d, n = 3/2 d / q:
+         * dy = f(y) as rates(), for the stages of adaptive(): the rates only (no
+         * Rates filled), in the q^2 form of FusedForwardEuler. With d = dev(xi),
+         * q^2 = 3/2 d:d, n = 3/2 d / q:
          *   lambda' n = g d, lambda' D n = g D d, |lambda'| = 2/3 |g| q,
          *   g = nu_s H1 H2 9/4 d:De / (eta (H' q^2 + 9/4 d:D:d)),
-         * which equals rates() up to round-off with one square root and one
-         * division fewer (no n, no lambda1). Returns H1; @p info (if given): q,
-         * sigma_y, H1, H2 and nu_s of the state.
+         * which equals rates() up to round-off without n and lambda1. For even n,
+         * H1 = t^(n/2) with t = q^2 / sigma_y^2 (no square root on the path to g; the
+         * one for |lambda'| runs aside). In 3D and plane strain without degradation
+         * d is a full traceless K vector, D d = 2 mu d and d:D:d = 4/3 mu q^2, so
+         *   g = H2 (H1 / q^2) d:De 9/4 / (H' + 3 mu),   H1 / q^2 = t^(n/2 - 1) / sigma_y^2:
+         * no division that waits for the deviator. Returns H1; @p info (if given):
+         * what it knows about the state.
          */
-        static double
+        static inline __attribute__((always_inline)) double
         stage_rates(const Constants &c,
                     const double    *y,
                     const VecK      &De,
                     double          *dy,
-                    Rates           *info = nullptr)
+                    Stage           *info = nullptr)
         {
-          VecF xi;
-          for (unsigned int f = 0; f < F; ++f)
-            xi[f] = kinematic ? -c.kin * y[i_epsp + f] : 0.0;
+          Stage st;
+          stage_begin(c, y, De, st);
+          stage_end(c, y, De, st, dy);
+          if (info)
+            *info = st;
+          return st.H1;
+        }
+
+        /// The first part of stage_rates(): the deviator and the products with it
+        /// (into @p st; everything up to the power and the divisions).
+        static inline __attribute__((always_inline)) void
+        stage_begin(const Constants &c, const double *y, const VecK &De, Stage &st)
+        {
+          constexpr bool radial = S != StressState::plane_stress && !degrading;
+          VecF           d;
+          const double   q2 = deviator(c, y, d);
+          // D d and the products straight from d (no gathered copy of it).
+          VecK   Dd;
+          double dDd = 0, dDe = 0, tr = 0;
+          for (unsigned int a = 0; a < n_nor; ++a)
+            tr += d[G::full[a]];
           for (unsigned int a = 0; a < K; ++a)
-            xi[G::full[a]] += y[a];
-          const double p = (xi[0] + xi[1] + xi[2]) * (1.0 / 3.0);
-          xi[0] -= p;
-          xi[1] -= p;
-          xi[2] -= p;
-          const double q2 = 1.5 * dot<F>(xi.data(), xi.data());
-          VecK         d_K, Dd;
-          for (unsigned int a = 0; a < K; ++a)
-            d_K[a] = xi[G::full[a]];
-          apply_D(c, d_K.data(), Dd.data());
-          double       eta = 1, nu = 1;
-          const double sigma_y = c.sigma_y0 + c.iso * y[i_eps_ps];
+            {
+              const double da = d[G::full[a]];
+              Dd[a]           = c.two_mu * da + (!radial && a < n_nor ? c.lambda_eff * tr : 0.0);
+              dDd += da * Dd[a];
+              dDe += da * De[a];
+            }
+          if (!radial)
+            st.dDd = dDd;
+          st.sigma_y = c.sigma_y0 + c.iso * y[i_eps_ps];
           if (degrading)
             {
-              eta = eta_of(c, y[i_eps_ps]);
-              nu  = 1.0 + c.c_nu_scaled * y[i_e_h];
+              st.eta = eta_of(c, y[i_eps_ps]);
+              st.nu  = 1.0 + c.c_nu_scaled * y[i_e_h];
             }
-          double g = 0, H1 = 0, q = 0, H2 = c.beta;
-          if (q2 > 0)
+          st.dDe = dDe;
+          st.H2  = c.beta + c.gamma * sign(dDe);
+          st.q2  = q2;
+          st.d   = d;
+          st.Dd  = Dd;
+        }
+
+        /// The second part of stage_rates(): H1, g and the rates dy.
+        static inline __attribute__((always_inline)) void
+        stage_end(const Constants &c, const double *y, const VecK &De, Stage &st, double *dy)
+        {
+          constexpr bool radial = S != StressState::plane_stress && !degrading;
+          const double   q2 = st.q2, sigma_y = st.sigma_y, eta = st.eta, dDe = st.dDe;
+          const double   q  = std::sqrt(q2);
+          double         H1 = 0, g = 0;
+          if (c.n_half != 0 && radial)
             {
-              q               = std::sqrt(q2);
-              const double dDd = dot<K>(d_K.data(), Dd.data());
-              const double dDe = dot<K>(d_K.data(), De.data());
-              H1               = power(c, q / sigma_y);
-              H2               = c.beta + c.gamma * sign(dDe);
-              const double den = c.H * q2 + 2.25 * dDd;
-              g                = nu * H1 * H2 * 2.25 * dDe / (degrading ? eta * den : den);
+              const double inv_sy2 = 1.0 / (sigma_y * sigma_y);
+              double       t_m;
+              H1 = power_pair(q2 * inv_sy2, c.n_half, t_m);
+              g  = st.H2 * (t_m * inv_sy2) * dDe * c.radial_g; // d = 0: dDe = 0, g = 0
+            }
+          else if (c.n_half != 0)
+            {
+              // One division for 1 / sigma_y^2 and 1 / den: inv = 1 / (sigma_y^2 den).
+              const double den = q2 > 0 ? c.H * q2 + 2.25 * st.dDd : 1.0;
+              const double sy2 = sigma_y * sigma_y;
+              const double inv = 1.0 / (sy2 * den);
+              H1               = integer_power(q2 * (den * inv), c.n_half);
+              g = st.nu * H1 * st.H2 * 2.25 * dDe * (sy2 * inv) / (degrading ? eta : 1.0);
+            }
+          else if (q2 > 0)
+            {
+              H1 = power(c, q / sigma_y);
+              g  = radial ? st.H2 * (H1 / q2) * dDe * c.radial_g :
+                            st.nu * H1 * st.H2 * 2.25 * dDe /
+                             ((degrading ? eta : 1.0) * (c.H * q2 + 2.25 * st.dDd));
             }
           for (unsigned int a = 0; a < K; ++a)
-            dy[a] = (degrading ? De[a] / eta : De[a]) - g * Dd[a];
+            dy[a] = (degrading ? De[a] / eta : De[a]) - g * st.Dd[a];
           for (unsigned int f = 0; f < F; ++f)
-            dy[i_epsp + f] = g * xi[f];
+            dy[i_epsp + f] = g * st.d[f];
           dy[i_eps_ps] = std::abs(g) * q * (2.0 / 3.0);
           if (degrading)
-            dy[i_e_h] = g * dot<K>(y, d_K.data());
+            {
+              double sd = 0;
+              for (unsigned int a = 0; a < K; ++a)
+                sd += y[a] * st.d[G::full[a]];
+              dy[i_e_h] = g * sd;
+            }
           if (track_eps_zz)
             dy[i_eps_zz] = eta * (-c.nu / c.E * (dy[0] + dy[1]) + dy[i_epsp + 2]);
-          if (info)
-            {
-              info->q       = q;
-              info->sigma_y = sigma_y;
-              info->H1      = H1;
-              info->H2      = H2;
-              info->nu      = nu;
-              info->eta     = eta;
-            }
-          return H1;
+          st.q  = q;
+          st.H1 = H1;
         }
 
         /// E_t = (D - nu_s H1 H2 lambda1 (D n) (x) (D n)) / eta (eq. 2.47, Mandel).
@@ -636,29 +732,152 @@ namespace hysteron
             }
         }
 
+        /// d = dev(sigma - alpha) of the state y; returns q^2 = 3/2 d:d. (Computed in
+        /// registers and stored once: reading d back right after storing it
+        /// component-wise would stall on store forwarding.)
+        static inline __attribute__((always_inline)) double
+        deviator(const Constants &c, const double *y, VecF &d)
+        {
+          VecF x;
+          for (unsigned int f = 0; f < F; ++f)
+            x[f] = kinematic ? -c.kin * y[i_epsp + f] : 0.0;
+          for (unsigned int a = 0; a < K; ++a)
+            x[G::full[a]] += y[a];
+          const double p  = (x[0] + x[1] + x[2]) * (1.0 / 3.0);
+          double       dd = 0;
+          for (unsigned int f = 0; f < F; ++f)
+            {
+              x[f] -= (f < 3 ? p : 0.0);
+              dd += x[f] * x[f];
+            }
+          d = x;
+          return 1.5 * dd;
+        }
+
         /**
-         * Bogacki-Shampine 3(2) with first-same-as-last and error control over the
-         * pseudo time s in [0, 1]; r: the rates at the end state. Returns the
-         * number of attempted sub-steps. With @p full_rates = false only r.q,
-         * r.sigma_y, r.H1, r.H2, r.nu and r.eta are set (enough to store the state;
-         * the tangent needs the full Rates).
+         * drift_correction() without degradation, in the q^2 form of stage_rates()
+         * and starting from its Stage of y: Newton's method on q - sigma_y in
+         * dlambda along n = 3/2 d / q, with the slope
+         *   n:D:n + H' = (H' q^2 + 9/4 d:D:d) / q^2,
+         * i.e. dlambda = (q - sigma_y) q^2 / den and lambda n = phi d,
+         * phi = 3/2 (q - sigma_y) q / den, den = H' q^2 + 9/4 d:D:d (= q^2 (H' + 3 mu)
+         * in 3D and plane strain, where d:D:d = 4/3 mu q^2 and one step is exact).
+         * Sets r.H1 (r.q is left as it is: the caller stores H1 only).
+         */
+        static inline __attribute__((always_inline)) void
+        drift_correction_stage(const Constants &c, VecN &y, const Stage &stage, Rates &r)
+        {
+          constexpr bool radial = S != StressState::plane_stress;
+          VecF           d  = stage.d;
+          VecK           Dd = stage.Dd;
+          double         q2 = stage.q2, q = stage.q, sy = stage.sigma_y, dDd = stage.dDd;
+          for (unsigned int iteration = 0; iteration < 5; ++iteration)
+            {
+              // dlambda = (q - sigma_y) / slope, phi = 3/2 dlambda / q
+              const double x = radial ? (q - sy) / (q * c.H_3mu) :
+                                        (q - sy) * q / (c.H * q2 + 2.25 * dDd);
+              const double phi = 1.5 * x;
+              for (unsigned int a = 0; a < K; ++a)
+                y[a] -= phi * Dd[a];
+              for (unsigned int f = 0; f < F; ++f)
+                y[i_epsp + f] += phi * d[f];
+              y[i_eps_ps] += x * q;
+              q2 = deviator(c, y.data(), d);
+              sy = c.sigma_y0 + c.iso * y[i_eps_ps];
+              if (!(q2 > sy * sy * (1 + 2e-14)))
+                break;
+              q = std::sqrt(q2);
+              VecK d_K;
+              for (unsigned int a = 0; a < K; ++a)
+                d_K[a] = d[G::full[a]];
+              if (radial)
+                for (unsigned int a = 0; a < K; ++a)
+                  Dd[a] = c.two_mu * d_K[a];
+              else
+                {
+                  apply_D(c, d_K.data(), Dd.data());
+                  dDd = dot<K>(d_K.data(), Dd.data());
+                }
+            }
+          const double t = q2 / (sy * sy);
+          r.H1           = c.n_half != 0 ? integer_power(t, c.n_half) : power(c, std::sqrt(t));
+        }
+
+        /**
+         * The end of an accepted increment: the drift correction if nu_s H1 > 1.
+         * With @p full, @p r holds the full Rates of y; else @p r receives q,
+         * sigma_y, H1, H2, nu_s and eta from @p stage (the last stage_rates() of y)
+         * and the correction starts from the stage (without degradation) or from
+         * rates() (with degradation).
+         */
+        static inline __attribute__((always_inline)) void
+        finish(const Constants &c,
+               VecN            &y,
+               const VecK      &De,
+               const Stage     &stage,
+               Rates           &r,
+               const bool       full)
+        {
+          if (!full)
+            {
+              r.q       = stage.q;
+              r.sigma_y = stage.sigma_y;
+              r.H1      = stage.H1;
+              r.H2      = stage.H2;
+              r.nu      = stage.nu;
+              r.eta     = stage.eta;
+            }
+          const double target = r.sigma_y * (degrading ? std::pow(r.nu, -1.0 / c.n) : 1.0);
+          if (!(r.q > target * (1 + 1e-14)))
+            return;
+          if (!full)
+            {
+              if constexpr (!degrading)
+                {
+                  drift_correction_stage(c, y, stage, r);
+                  return;
+                }
+              VecN dy;
+              rates(c, y.data(), De, dy.data(), r);
+            }
+          drift_correction(c, y, r);
+        }
+
+        /// Per-step error estimate of Bogacki-Shampine 3(2), scaled (error_norm()).
+        static double
+        bs32_error(const Constants &c,
+                   const double     h,
+                   const VecN      &k1,
+                   const VecN      &k2,
+                   const VecN      &k3,
+                   const VecN      &k4)
+        {
+          VecN err;
+          for (unsigned int i = 0; i < N; ++i)
+            err[i] = h * (-5.0 / 72.0 * k1[i] + 1.0 / 12.0 * k2[i] + 1.0 / 9.0 * k3[i] -
+                          0.125 * k4[i]);
+          return error_norm(c, err);
+        }
+
+        /**
+         * The sub-step loop of adaptive() from s = 0 with the trial step @p h,
+         * k1 = f(y) and @p attempts attempts already spent (by a rejected first
+         * attempt of adaptive_points()). See adaptive().
          */
         static unsigned int
-        adaptive(const Constants &c,
+        substeps(const Constants &c,
                  VecN            &y,
-                 const VecK      &deps,
+                 const VecK      &De,
+                 VecN            &k1,
+                 double           H1_now,
+                 double           h,
+                 unsigned int     attempts,
                  Rates           &r,
-                 const bool       full_rates = true)
+                 const bool       full_rates)
         {
-          VecK De;
-          apply_D(c, deps.data(), De.data());
-          VecN  k1, k2, k3, k4, yt, y_new, err;
-          // Only the end state's Rates are needed (tangent, drift correction,
-          // stored H1 and H2): all stages use stage_rates(); rates() is evaluated
-          // once at the end state if the drift correction or the caller needs it.
-          double H1_now = stage_rates(c, y.data(), De, k1.data());
-          double       s = 0, h = 1;
-          unsigned int attempts = 0;
+          VecN   k2, k3, k4, yt, y_new;
+          Stage  stage;
+          double s = 0;
           while (true)
             {
               if (++attempts > c.max_substeps)
@@ -684,11 +903,8 @@ namespace hysteron
               const bool   full_new = last && full_rates;
               const double H1_new   = full_new ?
                                         (rates(c, y_new.data(), De, k4.data(), r), r.H1) :
-                                        stage_rates(c, y_new.data(), De, k4.data(), &r);
-              for (unsigned int i = 0; i < N; ++i)
-                err[i] = h * (-5.0 / 72.0 * k1[i] + 1.0 / 12.0 * k2[i] + 1.0 / 9.0 * k3[i] -
-                              0.125 * k4[i]);
-              const double e = error_norm(c, err);
+                                        stage_rates(c, y_new.data(), De, k4.data(), &stage);
+              const double e        = bs32_error(c, h, k1, k2, k3, k4);
               if (!std::isfinite(e))
                 {
                   // Overflow in a too long trial step (H1 = (q/sigma_y)^n explodes for
@@ -712,17 +928,7 @@ namespace hysteron
                   H1_now = H1_new;
                   if (last)
                     {
-                      // r: the full Rates of y, or q, sigma_y, nu_s (stage_rates()).
-                      const double target =
-                        r.sigma_y * (degrading ? std::pow(r.nu, -1.0 / c.n) : 1.0);
-                      const bool drift = r.q > target * (1 + 1e-14);
-                      if (drift && !full_new)
-                        {
-                          VecN dy;
-                          rates(c, y.data(), De, dy.data(), r);
-                        }
-                      if (drift)
-                        drift_correction(c, y, r);
+                      finish(c, y, De, stage, r, full_new);
                       return attempts;
                     }
                   s += h;
@@ -740,6 +946,87 @@ namespace hysteron
                        "Material/Bouc-Wen/Tolerance.";
                   throw RuntimeError(m.str());
                 }
+            }
+        }
+
+        /**
+         * Bogacki-Shampine 3(2) with first-same-as-last and error control over the
+         * pseudo time s in [0, 1]; r: the rates at the end state. Returns the
+         * number of attempted sub-steps. With @p full_rates = false only r.q,
+         * r.sigma_y, r.H1, r.H2, r.nu and r.eta are set (enough to store the state;
+         * the tangent needs the full Rates).
+         */
+        static unsigned int
+        adaptive(const Constants &c,
+                 VecN            &y,
+                 const VecK      &deps,
+                 Rates           &r,
+                 const bool       full_rates = true)
+        {
+          VecK De;
+          apply_D(c, deps.data(), De.data());
+          VecN  k1;
+          Stage st;
+          stage_rates(c, y.data(), De, k1.data(), &st);
+          return substeps(c, y, De, k1, st.H1, 1.0, 0, r, full_rates);
+        }
+
+        /**
+         * adaptive() without the full Rates for P independent points: the first
+         * attempt (the whole increment, h = 1, which most increments accept) runs
+         * stage by stage over all points, so that the processor overlaps their
+         * dependency chains; a point whose first attempt is rejected continues in
+         * substeps() from the step size its error estimate suggests. Same
+         * operations per point as adaptive(), hence the same results.
+         */
+        template <unsigned int P>
+        static inline __attribute__((always_inline)) void
+        adaptive_points(const Constants &c, VecN *y, const VecK *deps, Rates *r)
+        {
+          VecK  De[P];
+          VecN  k1[P], k2[P], k3[P], k4[P], yt[P];
+          Stage st[P];
+          // One stage for all points: the deviators first, then the powers and
+          // divisions, which thus overlap.
+          const auto stage = [&](const VecN *x, VecN *k) {
+            for (unsigned int p = 0; p < P; ++p)
+              stage_begin(c, x[p].data(), De[p], st[p]);
+            for (unsigned int p = 0; p < P; ++p)
+              stage_end(c, x[p].data(), De[p], st[p], k[p].data());
+          };
+          for (unsigned int p = 0; p < P; ++p)
+            apply_D(c, deps[p].data(), De[p].data());
+          stage(y, k1);
+          double H1[P];
+          for (unsigned int p = 0; p < P; ++p)
+            {
+              H1[p] = st[p].H1;
+              for (unsigned int i = 0; i < N; ++i)
+                yt[p][i] = y[p][i] + 0.5 * k1[p][i];
+            }
+          stage(yt, k2);
+          for (unsigned int p = 0; p < P; ++p)
+            for (unsigned int i = 0; i < N; ++i)
+              yt[p][i] = y[p][i] + 0.75 * k2[p][i];
+          stage(yt, k3);
+          for (unsigned int p = 0; p < P; ++p)
+            for (unsigned int i = 0; i < N; ++i)
+              yt[p][i] =
+                y[p][i] + (2.0 / 9.0 * k1[p][i] + 1.0 / 3.0 * k2[p][i] + 4.0 / 9.0 * k3[p][i]);
+          stage(yt, k4);
+          for (unsigned int p = 0; p < P; ++p)
+            {
+              const double e = bs32_error(c, 1.0, k1[p], k2[p], k3[p], k4[p]);
+              if (e <= 1.0)
+                {
+                  y[p] = yt[p];
+                  finish(c, y[p], De[p], st[p], r[p], false);
+                }
+              else if (std::isfinite(e))
+                substeps(
+                  c, y[p], De[p], k1[p], H1[p], std::max(0.2, 0.9 / std::cbrt(e)), 1, r[p], false);
+              else // repeat the attempt in substeps(), which shortens or throws
+                substeps(c, y[p], De[p], k1[p], H1[p], 1.0, 0, r[p], false);
             }
         }
 

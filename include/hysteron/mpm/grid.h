@@ -41,13 +41,16 @@ namespace hysteron
 
       /**
        * Create the grid: cells of size @p h from @p lower; @p n_cells per
-       * direction; @p n_components doubles per node.
+       * direction; @p n_components doubles per node. With @p work_per_cell (in
+       * lattice order, e.g. the material points of each cell) p4est balances
+       * that work instead of the number of cells between the ranks.
        */
       void
       initialize(const dealii::Point<dim>            &lower,
                  const double                          h,
                  const std::array<unsigned int, dim> &n_cells,
-                 const unsigned int                    n_components);
+                 const unsigned int                    n_components,
+                 const std::vector<unsigned int>      &work_per_cell = {});
 
       const Lattice<dim> &
       lattice() const

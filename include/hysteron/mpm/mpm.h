@@ -225,6 +225,7 @@ namespace hysteron
       std::unique_ptr<Output::CsvWriter>            reaction_table;
       std::vector<std::string>                      state_names;
       std::vector<unsigned int>                     group_of_body;
+      std::vector<std::vector<dealii::Point<dim>>>  body_points; ///< set-up only
       std::vector<typename ParticleStore<dim>::Group> group_templates;
       unsigned int                                  current_group_key = 0;
       unsigned int                                  n_properties      = 0;
