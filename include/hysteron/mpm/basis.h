@@ -255,7 +255,7 @@ namespace hysteron
        * Used by evaluate(); exposed so that both one-sided limits at a cell
        * face can be evaluated exactly.
        */
-      static inline void
+      DEAL_II_ALWAYS_INLINE static inline void
       evaluate_in_cell(const unsigned int cell,
                        const double       t,
                        const unsigned int /*n_cells*/,
@@ -274,7 +274,7 @@ namespace hysteron
        * Support of the lattice coordinate @p xi (clamped into [0, n_cells]):
        * nodes first, first+1 with first the cell index.
        */
-      static inline void
+      DEAL_II_ALWAYS_INLINE static inline void
       evaluate(double             xi,
                const unsigned int n_cells,
                int &              first,
@@ -314,7 +314,7 @@ namespace hysteron
        * @p n_cells cells. Exposed so that both one-sided limits at a cell face
        * can be evaluated exactly.
        */
-      static inline void
+      DEAL_II_ALWAYS_INLINE static inline void
       evaluate_in_cell(const unsigned int cell,
                        const double       t,
                        const unsigned int n_cells,
@@ -375,7 +375,7 @@ namespace hysteron
       /**
        * Support of the lattice coordinate @p xi (clamped into [0, n_cells]).
        */
-      static inline void
+      DEAL_II_ALWAYS_INLINE static inline void
       evaluate(double             xi,
                const unsigned int n_cells,
                int &              first,
