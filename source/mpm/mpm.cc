@@ -112,6 +112,13 @@ namespace hysteron
                           "Write particles.csv at the end: one row per material point (id, body, "
                           "position, displacement, velocity, stress, von Mises stress, strain, "
                           "material state), sorted by id.");
+        prm.declare_entry("Average regions",
+                          "",
+                          Patterns::Anything(),
+                          "Regions separated by ';' (doc/geometry.md); for each, average_<i>.csv "
+                          "holds the mass-weighted mean of the probe columns over the points that "
+                          "started in the region (e.g. the mean velocity of a body, a section's "
+                          "mean stress), every `Probe interval`.");
         prm.declare_entry("Probe interval",
                           "0",
                           Patterns::Double(),
@@ -170,6 +177,10 @@ namespace hysteron
         maximum_cfl    = s.get_positive("Maximum CFL number");
         probe_interval = s.get_non_negative("Probe interval");
         particle_table = s.get_bool("Write particle table");
+        average_regions.clear();
+        for (const auto &expression : dealii::Utilities::split_string_list(s.get("Average regions"), ';'))
+          if (!expression.empty())
+            average_regions.push_back(Geometry::Region<dim>::parse(expression, s.where("Average regions")));
       }
 
       // The scene's bodies must lie in the grid.
@@ -756,6 +767,14 @@ namespace hysteron
           probe_tables.push_back(std::make_unique<Output::CsvWriter>(
             scene.output_file("probe_" + std::to_string(i) + ".csv"), columns));
         }
+      for (unsigned int i = 0; i < average_regions.size(); ++i)
+        {
+          std::vector<std::string> columns{"time", "mass"};
+          const auto               point = point_columns();
+          columns.insert(columns.end(), point.begin(), point.end());
+          average_tables.push_back(std::make_unique<Output::CsvWriter>(
+            scene.output_file("average_" + std::to_string(i) + ".csv"), columns));
+        }
       energy_table = std::make_unique<Output::CsvWriter>(
         scene.output_file("energy.csv"),
         std::vector<std::string>{"time",
@@ -893,6 +912,23 @@ namespace hysteron
         if (probes[i].local >= 0)
           point_values(probes[i].local, rows.data() + i * n_columns + 1);
 
+      // Mass-weighted averages over the points that started in each region.
+      const unsigned int  n_values = n_columns - 1;
+      std::vector<double> averages(average_regions.size() * (1 + n_values), 0.0);
+      std::vector<double> values(n_values);
+      for (unsigned int i = 0; i < average_regions.size(); ++i)
+        for (const auto &group : P.groups)
+          if (group.material != nullptr)
+            for (unsigned int s = group.begin; s < group.end; ++s)
+              if (average_regions[i].contains(P.x0[s], 1e-9 * cell_size))
+                {
+                  double *a = averages.data() + i * (1 + n_values);
+                  point_values(s, values.data());
+                  a[0] += P.mass[s];
+                  for (unsigned int c = 0; c < n_values; ++c)
+                    a[1 + c] += P.mass[s] * values[c];
+                }
+
       // Energies of this rank's points: kinetic and elastic strain energy
       // w = ((1 + nu) sigma : sigma - nu tr(sigma)^2) / (2 E) (with sigma_zz in 2D).
       double kinetic = 0, strain_energy = 0;
@@ -924,7 +960,7 @@ namespace hysteron
           reaction_values.push_back(r[d]);
       if (grid->is_parallel())
         {
-          for (auto *v : {&rows, &sums, &reaction_values})
+          for (auto *v : {&rows, &sums, &reaction_values, &averages})
             if (!v->empty())
               MPI_Allreduce(MPI_IN_PLACE, v->data(), v->size(), MPI_DOUBLE, MPI_SUM, comm);
         }
@@ -935,6 +971,14 @@ namespace hysteron
           std::vector<double> row(rows.begin() + i * n_columns, rows.begin() + (i + 1) * n_columns);
           row[0] = t;
           probe_tables[i]->add_row(row);
+        }
+      for (unsigned int i = 0; i < average_regions.size(); ++i)
+        {
+          const double       *a = averages.data() + i * (1 + n_values);
+          std::vector<double> row{t, a[0]};
+          for (unsigned int c = 0; c < n_values; ++c)
+            row.push_back(a[0] > 0 ? a[1 + c] / a[0] : 0.0);
+          average_tables[i]->add_row(row);
         }
       if (!energy_logged)
         {
@@ -969,6 +1013,8 @@ namespace hysteron
     Solver<dim>::commit_tables()
     {
       for (auto &table : probe_tables)
+        table->commit();
+      for (auto &table : average_tables)
         table->commit();
       if (energy_table)
         energy_table->commit();

@@ -5,6 +5,7 @@
 #include <deal.II/particles/particle_handler.h>
 
 #include <hysteron/base/output.h>
+#include <hysteron/geometry/region.h>
 #include <hysteron/mpm/grid.h>
 #include <hysteron/mpm/particles.h>
 #include <hysteron/scene/method.h>
@@ -105,6 +106,7 @@ namespace hysteron
       double                        maximum_cfl   = 1.0;
       double                        probe_interval = 0.0;
       bool                          particle_table = false;
+      std::vector<Geometry::Region<dim>> average_regions;
       double                        small_mass = 0; ///< nodes lighter than this have no velocity
 
       // Set-up and the pieces of run().
@@ -221,6 +223,7 @@ namespace hysteron
       unsigned int                                  n_rebuilds = 0;
       std::unique_ptr<Output::FieldWriter>          field_writer;
       std::vector<std::unique_ptr<Output::CsvWriter>> probe_tables;
+      std::vector<std::unique_ptr<Output::CsvWriter>> average_tables;
       std::unique_ptr<Output::CsvWriter>            energy_table;
       std::unique_ptr<Output::CsvWriter>            reaction_table;
       std::vector<std::string>                      state_names;
