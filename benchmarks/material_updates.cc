@@ -2,6 +2,7 @@
 // integrator against a converged reference on the same cyclic, non-proportional strain path.
 //
 //   benchmarks/material_updates [--repeats 5] [--points 1000] [--csv FILE]
+//                               [--only "plane stress/adaptive/8"]  (one case, no reference)
 //
 // For every stress state (plane stress, plane strain, 3D), Bouc-Wen integrator (forward Euler,
 // adaptive, backward Euler) and smoothness n in {2, 8, 32}, a batch of points follows the path
@@ -13,6 +14,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/timer.h>
+#include <deal.II/base/utilities.h>
 
 #include <hysteron/base/output.h>
 #include <hysteron/base/parameters.h>
@@ -171,6 +173,7 @@ main(int argc, char **argv)
   Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
   unsigned int repeats = 5, points = 1000, steps_per_cycle = 600;
   std::string  csv_file = "material_updates.csv";
+  std::string  only; // "state/integrator/n": time this case alone (profiling), no error
   for (int i = 1; i + 1 < argc; i += 2)
     {
       const std::string a = argv[i];
@@ -182,11 +185,33 @@ main(int argc, char **argv)
         steps_per_cycle = std::atoi(argv[i + 1]);
       else if (a == "--csv")
         csv_file = argv[i + 1];
+      else if (a == "--only")
+        only = argv[i + 1];
       else
         {
-          std::cerr << "usage: material_updates [--repeats R] [--points P] [--steps S] [--csv F]\n";
+          std::cerr << "usage: material_updates [--repeats R] [--points P] [--steps S] [--csv F]"
+                       " [--only 'state/integrator/n']\n";
           return 1;
         }
+    }
+
+  if (!only.empty())
+    {
+      const auto parts = Utilities::split_string_list(only, '/');
+      if (parts.size() != 3)
+        {
+          std::cerr << "material_updates: --only needs 'state/integrator/n'\n";
+          return 1;
+        }
+      const Case c{parts[0], "bouc-wen", parts[1], Utilities::string_to_double(parts[2])};
+      double     seconds = 0;
+      if (c.state == "3D")
+        run_path<3>(*make_material<3>(c, 1e-6), points, steps_per_cycle, seconds);
+      else
+        run_path<2>(*make_material<2>(c, 1e-6), points, steps_per_cycle, seconds);
+      std::cout << only << ": " << double(points) * 2 * steps_per_cycle / seconds / 1e6
+                << " M updates/s" << std::endl;
+      return 0;
     }
 
   hysteron::Output::CsvWriter csv(csv_file,

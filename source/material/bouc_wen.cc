@@ -480,7 +480,7 @@ namespace hysteron
             {
               // Interleaved first attempts (Law::adaptive_points()); no tangent, so
               // only the end state's H1 and H2 are needed.
-              constexpr unsigned int n_points = 4;
+              constexpr unsigned int n_points = 8;
               typename L::VecN       y[n_points];
               typename L::VecK       deps[n_points];
               typename L::Rates      r[n_points];
@@ -577,6 +577,7 @@ namespace hysteron
       c.inv_m_u1     = 1.0 / (c.m_u + 1.0);
       c.c_nu_scaled  = parameters.strength_deterioration_c_nu / (c.sigma_y0 * c.eps_y);
       c.tol          = parameters.tolerance;
+      c.inv_tol      = 1.0 / c.tol;
       c.inv_sigma_y0 = 1.0 / c.sigma_y0;
       c.inv_eps_y    = 1.0 / c.eps_y;
       c.inv_energy   = 1.0 / (c.sigma_y0 * c.eps_y);

@@ -154,6 +154,7 @@ namespace hysteron
         double       c_eta = 0, m_u = 1, inv_m_u1 = 0.5; ///< 1 / (m_u + 1)
         double       c_nu_scaled  = 0;                   ///< c_nu / (sigma_y0 eps_y)
         double       tol          = 1e-6;
+        double       inv_tol      = 1e6; ///< 1 / tol
         double       inv_sigma_y0 = 1, inv_eps_y = 1, inv_energy = 1;
         unsigned int max_substeps   = 100000;
         unsigned int max_iterations = 50;
@@ -445,6 +446,8 @@ namespace hysteron
           VecK   Dd; ///< D d (K components)
           double q2 = 0, q = 0, sigma_y = 1, H1 = 0, H2 = 0, eta = 1, nu = 1;
           double dDe = 0, dDd = 0; ///< d:D:deps, d:D:d (plane stress or degradation)
+          /// 1 / sigma_y^2 and (plane stress, even n) 1 / (H' q^2 + 9/4 d:D:d); 0: not set
+          double inv_sy2 = 0, inv_den = 0;
         };
 
         /// dy = f(y) for the strain increment deps (De = D deps).
@@ -540,10 +543,12 @@ namespace hysteron
         stage_begin(const Constants &c, const double *y, const VecK &De, Stage &st)
         {
           constexpr bool radial = S != StressState::plane_stress && !degrading;
-          VecF           d;
-          const double   q2 = deviator(c, y, d);
+          // d and D d straight into st (a copy of local arrays was assembled on the
+          // stack with scalar stores and read back as pairs: store-forwarding stalls).
+          VecF        &d  = st.d;
+          const double q2 = deviator(c, y, d);
           // D d and the products straight from d (no gathered copy of it).
-          VecK   Dd;
+          VecK  &Dd  = st.Dd;
           double dDd = 0, dDe = 0, tr = 0;
           for (unsigned int a = 0; a < n_nor; ++a)
             tr += d[G::full[a]];
@@ -565,8 +570,6 @@ namespace hysteron
           st.dDe = dDe;
           st.H2  = c.beta + c.gamma * sign(dDe);
           st.q2  = q2;
-          st.d   = d;
-          st.Dd  = Dd;
         }
 
         /// The second part of stage_rates(): H1, g and the rates dy.
@@ -583,6 +586,7 @@ namespace hysteron
               double       t_m;
               H1 = power_pair(q2 * inv_sy2, c.n_half, t_m);
               g  = st.H2 * (t_m * inv_sy2) * dDe * c.radial_g; // d = 0: dDe = 0, g = 0
+              st.inv_sy2 = inv_sy2;
             }
           else if (c.n_half != 0)
             {
@@ -590,8 +594,10 @@ namespace hysteron
               const double den = q2 > 0 ? c.H * q2 + 2.25 * st.dDd : 1.0;
               const double sy2 = sigma_y * sigma_y;
               const double inv = 1.0 / (sy2 * den);
-              H1               = integer_power(q2 * (den * inv), c.n_half);
-              g = st.nu * H1 * st.H2 * 2.25 * dDe * (sy2 * inv) / (degrading ? eta : 1.0);
+              st.inv_sy2       = den * inv;
+              st.inv_den       = sy2 * inv;
+              H1               = integer_power(q2 * st.inv_sy2, c.n_half);
+              g = st.nu * H1 * st.H2 * 2.25 * dDe * st.inv_den / (degrading ? eta : 1.0);
             }
           else if (q2 > 0)
             {
@@ -665,7 +671,7 @@ namespace hysteron
             e = max_nan(e, std::abs(err[i_e_h]) * c.inv_energy);
           if (track_eps_zz)
             e = max_nan(e, std::abs(err[i_eps_zz]) * c.inv_eps_y);
-          return e / c.tol;
+          return e * c.inv_tol;
         }
 
         /// The plastic correction y -> y + dlambda (-D n, n, 1, sigma:n, ...) along
@@ -732,9 +738,9 @@ namespace hysteron
             }
         }
 
-        /// d = dev(sigma - alpha) of the state y; returns q^2 = 3/2 d:d. (Computed in
-        /// registers and stored once: reading d back right after storing it
-        /// component-wise would stall on store forwarding.)
+        /// d = dev(sigma - alpha) of the state y; returns q^2 = 3/2 d:d. (Each component
+        /// is stored once from registers; a local copy assembled on the stack and
+        /// copied as a whole was read back as pairs and stalled on store forwarding.)
         static inline __attribute__((always_inline)) double
         deviator(const Constants &c, const double *y, VecF &d)
         {
@@ -747,10 +753,10 @@ namespace hysteron
           double       dd = 0;
           for (unsigned int f = 0; f < F; ++f)
             {
-              x[f] -= (f < 3 ? p : 0.0);
-              dd += x[f] * x[f];
+              const double v = x[f] - (f < 3 ? p : 0.0);
+              d[f]           = v;
+              dd += v * v;
             }
-          d = x;
           return 1.5 * dd;
         }
 
@@ -774,7 +780,10 @@ namespace hysteron
           for (unsigned int iteration = 0; iteration < 5; ++iteration)
             {
               // dlambda = (q - sigma_y) / slope, phi = 3/2 dlambda / q
+              // (The first step in plane stress reuses 1 / den of the stage.)
               const double x = radial ? (q - sy) / (q * c.H_3mu) :
+                               (iteration == 0 && stage.inv_den != 0) ?
+                                        (q - sy) * q * stage.inv_den :
                                         (q - sy) * q / (c.H * q2 + 2.25 * dDd);
               const double phi = 1.5 * x;
               for (unsigned int a = 0; a < K; ++a)
@@ -799,8 +808,14 @@ namespace hysteron
                   dDd = dot<K>(d_K.data(), Dd.data());
                 }
             }
-          const double t = q2 / (sy * sy);
-          r.H1           = c.n_half != 0 ? integer_power(t, c.n_half) : power(c, std::sqrt(t));
+          // t = q^2 / sigma_y^2 without a division: sigma_y moved by the tiny
+          // r = (sigma_y - sigma_y,stage) / sigma_y,stage, and 1 / (1 + r)^2 =
+          // 1 - 2 r + 3 r^2 + O(r^3) (exact to round-off for |r| < 1e-6).
+          const double r_sy = (sy - stage.sigma_y) * stage.sigma_y * stage.inv_sy2;
+          const double t    = (stage.inv_sy2 != 0 && std::abs(r_sy) < 1e-6) ?
+                                q2 * (stage.inv_sy2 * (1.0 - r_sy * (2.0 - 3.0 * r_sy))) :
+                                q2 / (sy * sy);
+          r.H1 = c.n_half != 0 ? integer_power(t, c.n_half) : power(c, std::sqrt(t));
         }
 
         /**
