@@ -38,7 +38,7 @@ namespace hysteron
         return s.str();
       }
 
-      const char *component_suffix[3] = {"x", "y", "z"};
+      const char *const *const component_suffix = PointData::component_names;
     } // namespace
 
 
@@ -112,18 +112,6 @@ namespace hysteron
                           "Write particles.csv at the end: one row per material point (id, body, "
                           "position, displacement, velocity, stress, von Mises stress, strain, "
                           "material state), sorted by id.");
-        prm.declare_entry("Average regions",
-                          "",
-                          Patterns::Anything(),
-                          "Regions separated by ';' (doc/geometry.md); for each, average_<i>.csv "
-                          "holds the mass-weighted mean of the probe columns over the points that "
-                          "started in the region (e.g. the mean velocity of a body, a section's "
-                          "mean stress), every `Probe interval`.");
-        prm.declare_entry("Probe interval",
-                          "0",
-                          Patterns::Double(),
-                          "Simulated time between rows of the probe, energy and reaction "
-                          "tables [s], >= 0; 0: every step.");
       }
       prm.leave_subsection();
     }
@@ -175,12 +163,9 @@ namespace hysteron
         require(flip_fraction <= 1.0, s.where("FLIP fraction"), "must be in [0, 1] (got " + s.get("FLIP fraction") + ")");
         jaumann        = s.get("Stress rate") == "Jaumann";
         maximum_cfl    = s.get_positive("Maximum CFL number");
-        probe_interval = s.get_non_negative("Probe interval");
         particle_table = s.get_bool("Write particle table");
-        average_regions.clear();
-        for (const auto &expression : dealii::Utilities::split_string_list(s.get("Average regions"), ';'))
-          if (!expression.empty())
-            average_regions.push_back(Geometry::Region<dim>::parse(expression, s.where("Average regions")));
+        probe_interval  = scene.output_control().probe_interval;
+        average_regions = scene.output_control().average_regions;
       }
 
       // The scene's bodies must lie in the grid.
@@ -620,7 +605,6 @@ namespace hysteron
           b.name       = description.name;
           b.type       = static_cast<unsigned int>(description.type);
           b.components = description.components;
-          b.velocity   = description.velocity.get();
           for (unsigned int n = 0; n < grid->n_local_nodes(); ++n)
             {
               if (!grid->is_relevant(n))
@@ -663,6 +647,7 @@ namespace hysteron
       using Type             = typename BoundaryDescription<dim>::Type;
       constexpr unsigned int C = 1 + 2 * dim;
       double *const          node = grid->data().data();
+      const auto            &scene_boundaries = this->get_scene().boundary_descriptions();
 
       // Set component c of node r to `target`: the velocity change joins the
       // FLIP increment, and m * change / dt is the reaction force on the body.
@@ -686,8 +671,8 @@ namespace hysteron
           const auto            &bc   = boundaries[b];
           const Type             type = static_cast<Type>(bc.type);
           dealii::Tensor<1, dim> prescribed;
-          if (type == Type::velocity)
-            prescribed = evaluate_in_time<dim>(*bc.velocity, t);
+          if (type == Type::velocity || type == Type::displacement)
+            prescribed = scene_boundaries[b].step_velocity(t, dt);
           for (unsigned int k = 0; k < bc.nodes.size(); ++k)
             {
               const unsigned int n = bc.nodes[k];
@@ -702,6 +687,7 @@ namespace hysteron
                       impose(r, c, 0.0, n, reactions[b]);
                     break;
                   case Type::velocity:
+                  case Type::displacement:
                     for (unsigned int c = 0; c < dim; ++c)
                       if (bc.components[c])
                         impose(r, c, prescribed[c], n, reactions[b]);
@@ -765,7 +751,7 @@ namespace hysteron
           const auto               point = point_columns();
           columns.insert(columns.end(), point.begin(), point.end());
           probe_tables.push_back(std::make_unique<Output::CsvWriter>(
-            scene.output_file("probe_" + std::to_string(i) + ".csv"), columns));
+            this->output_file("probe_" + std::to_string(i) + ".csv"), columns));
         }
       for (unsigned int i = 0; i < average_regions.size(); ++i)
         {
@@ -773,27 +759,12 @@ namespace hysteron
           const auto               point = point_columns();
           columns.insert(columns.end(), point.begin(), point.end());
           average_tables.push_back(std::make_unique<Output::CsvWriter>(
-            scene.output_file("average_" + std::to_string(i) + ".csv"), columns));
+            this->output_file("average_" + std::to_string(i) + ".csv"), columns));
         }
-      energy_table = std::make_unique<Output::CsvWriter>(
-        scene.output_file("energy.csv"),
-        std::vector<std::string>{"time",
-                                 "kinetic",
-                                 "strain_energy",
-                                 "internal_work",
-                                 "dissipated",
-                                 "external_work",
-                                 "boundary_work",
-                                 "balance"});
-      std::vector<std::string> columns{"time"};
-      for (const auto &b : scene.boundary_descriptions())
-        for (unsigned int d = 0; d < dim; ++d)
-          columns.push_back(b.name + "_" + component_suffix[d]);
-      for (const auto &b : scene.body_descriptions())
-        if (b.rigid)
-          for (unsigned int d = 0; d < dim; ++d)
-            columns.push_back(b.name + "_" + component_suffix[d]);
-      reaction_table = std::make_unique<Output::CsvWriter>(scene.output_file("reactions.csv"), columns);
+      energy_table = std::make_unique<Output::CsvWriter>(this->output_file("energy.csv"),
+                                                         PointData::energy_columns());
+      reaction_table = std::make_unique<Output::CsvWriter>(this->output_file("reactions.csv"),
+                                                           PointData::reaction_columns(scene));
     }
 
 
@@ -802,24 +773,7 @@ namespace hysteron
     std::vector<std::string>
     Solver<dim>::point_columns() const
     {
-      using PI = PropertiesIndex<dim>;
-      std::vector<std::string> columns;
-      for (const std::string prefix : {"x_", "u_", "v_"})
-        for (unsigned int d = 0; d < dim; ++d)
-          columns.push_back(prefix + component_suffix[d]);
-      for (const std::string prefix : {"s_", "eps_"})
-        {
-          for (unsigned int c = 0; c < PI::n_sym; ++c)
-            {
-              const auto ij = dealii::SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
-              columns.push_back(prefix + component_suffix[ij[0]] + component_suffix[ij[1]]);
-            }
-          if (prefix == "s_")
-            columns.push_back("von_mises");
-        }
-      for (const auto &name : state_names)
-        columns.push_back(name);
-      return columns;
+      return PointData::columns<dim>(state_names);
     }
 
 
@@ -828,35 +782,22 @@ namespace hysteron
     void
     Solver<dim>::point_values(const unsigned int s, double *r) const
     {
-      using namespace dealii;
-      using PI     = PropertiesIndex<dim>;
-      const auto  &P = particles;
-      unsigned int c = 0;
-      for (unsigned int d = 0; d < dim; ++d)
-        r[c++] = P.current.x[s][d];
-      for (unsigned int d = 0; d < dim; ++d)
-        r[c++] = P.current.x[s][d] - P.x0[s][d];
-      for (unsigned int d = 0; d < dim; ++d)
-        r[c++] = P.current.v[s][d];
+      const auto &P     = particles;
       const auto *group = &P.groups[0];
       for (const auto &g : P.groups)
         if (s >= g.begin && s < g.end)
           group = &g;
       const double *state = P.current.material_state.data() + group->state_offset +
                             std::size_t(s - group->begin) * group->n_state;
-      for (unsigned int k = 0; k < PI::n_sym; ++k)
-        r[c++] = P.current.stress[s][SymmetricTensor<2, dim>::unrolled_to_component_indices(k)];
-      double sigma_zz = 0, eps_zz = 0;
-      if (dim == 2 && group->material != nullptr)
-        group->material->out_of_plane(P.current.strain[s], P.current.stress[s],
-                                      view(state, group->n_state), eps_zz, sigma_zz);
-      const double tr = dealii::trace(P.current.stress[s]) + sigma_zz;
-      r[c++] = std::sqrt(std::max(0.0, 1.5 * ((P.current.stress[s] * P.current.stress[s]) +
-                                               sigma_zz * sigma_zz - tr * tr / 3.0)));
-      for (unsigned int k = 0; k < PI::n_sym; ++k)
-        r[c++] = P.current.strain[s][SymmetricTensor<2, dim>::unrolled_to_component_indices(k)];
-      for (unsigned int k = 0; k < state_names.size(); ++k)
-        r[c++] = k < group->n_state ? state[k] : 0.0;
+      PointData::values<dim>(P.current.x[s],
+                             P.current.x[s] - P.x0[s],
+                             P.current.v[s],
+                             P.current.stress[s],
+                             P.current.strain[s],
+                             group->material,
+                             view(state, group->n_state),
+                             state_names.size(),
+                             r);
     }
 
 
@@ -887,7 +828,7 @@ namespace hysteron
       std::sort(table.begin(), table.end());
       std::vector<std::string> header{"id", "body"};
       header.insert(header.end(), columns.begin(), columns.end());
-      Output::CsvWriter out(scene.output_file("particles.csv"), header);
+      Output::CsvWriter out(this->output_file("particles.csv"), header);
       for (const auto &row : table)
         out.add_row(row);
       out.commit();
@@ -929,29 +870,22 @@ namespace hysteron
                     a[1 + c] += P.mass[s] * values[c];
                 }
 
-      // Energies of this rank's points: kinetic and elastic strain energy
-      // w = ((1 + nu) sigma : sigma - nu tr(sigma)^2) / (2 E) (with sigma_zz in 2D).
+      // Energies of this rank's points: kinetic and elastic strain energy.
       double kinetic = 0, strain_energy = 0;
       for (const auto &group : P.groups)
         for (unsigned int s = group.begin; s < group.end; ++s)
           {
             kinetic += 0.5 * P.mass[s] * P.current.v[s].norm_square();
-            if (group.material == nullptr)
-              continue;
-            const auto  &e     = group.material->elasticity();
-            const auto  &sigma = P.current.stress[s];
-            double       sigma_zz = 0, eps_zz = 0;
-            if (dim == 2)
-              group.material->out_of_plane(P.current.strain[s], sigma,
-                                           view(P.current.material_state.data() + group.state_offset +
-                                                  std::size_t(s - group.begin) * group.n_state,
-                                                group.n_state),
-                                           eps_zz, sigma_zz);
-            const double tr = dealii::trace(sigma) + sigma_zz;
-            strain_energy += P.current.volume[s] *
-                             ((1 + e.poissons_ratio) * ((sigma * sigma) + sigma_zz * sigma_zz) -
-                              e.poissons_ratio * tr * tr) /
-                             (2 * e.youngs_modulus);
+            if (group.material != nullptr)
+              strain_energy +=
+                P.current.volume[s] *
+                PointData::strain_energy_density(*group.material,
+                                                 P.current.stress[s],
+                                                 P.current.strain[s],
+                                                 view(P.current.material_state.data() +
+                                                        group.state_offset +
+                                                        std::size_t(s - group.begin) * group.n_state,
+                                                      group.n_state));
           }
       std::vector<double> sums{kinetic, strain_energy, internal_work, external_work, boundary_work};
       std::vector<double> reaction_values;
@@ -980,20 +914,7 @@ namespace hysteron
             row.push_back(a[0] > 0 ? a[1 + c] / a[0] : 0.0);
           average_tables[i]->add_row(row);
         }
-      if (!energy_logged)
-        {
-          initial_kinetic = sums[0];
-          initial_strain  = sums[1];
-          energy_logged   = true;
-        }
-      energy_table->add_row({t,
-                             sums[0],
-                             sums[1],
-                             sums[2],
-                             sums[2] - sums[1] + initial_strain,
-                             sums[3],
-                             sums[4],
-                             sums[0] - initial_kinetic + sums[2] - sums[3] - sums[4]});
+      energy_table->add_row(energy_log.row(t, sums[0], sums[1], sums[2], sums[3], sums[4]));
       std::vector<double> row{t};
       const auto         &bodies = scene.body_descriptions();
       for (unsigned int b = 0; b < boundaries.size(); ++b)
@@ -1115,7 +1036,7 @@ namespace hysteron
         generate_particles();
         from_handler();
         setup_boundaries();
-        field_writer = std::make_unique<Output::FieldWriter>(scene.output_control().directory,
+        field_writer = std::make_unique<Output::FieldWriter>(this->output_directory(),
                                                              "particles",
                                                              scene.mpi_communicator());
         open_tables();

@@ -62,6 +62,34 @@ namespace hysteron
 
   template <int dim>
   dealii::Tensor<1, dim>
+  BoundaryDescription<dim>::displacement_increment(const double t0, const double t1) const
+  {
+    if (displacement)
+      return evaluate_in_time<dim>(*displacement, t1) - evaluate_in_time<dim>(*displacement, t0);
+    // 3-point Gauss-Legendre on [t0, t1]: exact for velocities of degree 5 in t.
+    const double           m = 0.5 * (t0 + t1), r = 0.5 * (t1 - t0), a = std::sqrt(0.6);
+    dealii::Tensor<1, dim> u = (5.0 / 9.0) * evaluate_in_time<dim>(*velocity, m - a * r) +
+                               (8.0 / 9.0) * evaluate_in_time<dim>(*velocity, m) +
+                               (5.0 / 9.0) * evaluate_in_time<dim>(*velocity, m + a * r);
+    return r * u;
+  }
+
+
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  BoundaryDescription<dim>::step_velocity(const double t, const double dt) const
+  {
+    if (velocity)
+      return evaluate_in_time<dim>(*velocity, t);
+    Assert(dt > 0, dealii::ExcMessage("a displacement needs the step length"));
+    return displacement_increment(std::max(t - dt, 0.0), t) / dt;
+  }
+
+
+
+  template <int dim>
+  dealii::Tensor<1, dim>
   LoadDescription<dim>::value_at(const double t) const
   {
     return evaluate_in_time<dim>(*value, t);
@@ -142,11 +170,13 @@ namespace hysteron
         prm.enter_subsection("Boundary " + name);
         prm.declare_entry("Type",
                           "fixed",
-                          Patterns::Selection("fixed|roller|wall|velocity"),
+                          Patterns::Selection("fixed|roller|wall|velocity|displacement"),
                           "fixed: all velocity components zero; roller: the normal component "
                           "zero (slip); wall: rigid frictionless wall, the body may slide and "
                           "separate but not penetrate (normal velocity into the wall set to zero); "
-                          "velocity: the `Components` follow `Velocity`(t).");
+                          "velocity: the `Components` follow `Velocity`(t); displacement: the "
+                          "`Components` follow `Displacement`(t) (displacement control; the MPM "
+                          "imposes the mean velocity of each step).");
         prm.declare_entry("Faces",
                           "",
                           Patterns::Anything(),
@@ -160,12 +190,19 @@ namespace hysteron
         prm.declare_entry("Components",
                           "all",
                           Patterns::Anything(),
-                          "velocity type: the prescribed components, a list of x, y, z or 'all'.");
+                          "velocity and displacement types: the prescribed components, a list of "
+                          "x, y, z or 'all'.");
         prm.declare_entry("Velocity",
                           "",
                           Patterns::Anything(),
                           "velocity type: the velocity [m/s] as functions of t, one per space "
                           "direction separated by ';' (entries of free components are unused).");
+        prm.declare_entry("Displacement",
+                          "",
+                          Patterns::Anything(),
+                          "displacement type: the displacement [m] from the initial position as "
+                          "functions of t, one per space direction separated by ';'; must vanish "
+                          "at t = 0 (entries of free components are unused).");
         prm.leave_subsection();
       }
     for (const auto &name : names.loads)
@@ -240,10 +277,11 @@ namespace hysteron
         Description b;
         b.name                 = name;
         const std::string type = s.get("Type");
-        b.type                 = type == "fixed"  ? Description::Type::fixed :
-                                 type == "roller" ? Description::Type::roller :
-                                 type == "wall"   ? Description::Type::wall :
-                                                    Description::Type::velocity;
+        b.type                 = type == "fixed"    ? Description::Type::fixed :
+                                 type == "roller"   ? Description::Type::roller :
+                                 type == "wall"     ? Description::Type::wall :
+                                 type == "velocity" ? Description::Type::velocity :
+                                                      Description::Type::displacement;
         for (const auto &f : s.get_list("Faces"))
           {
             bool found = false;
@@ -270,7 +308,7 @@ namespace hysteron
                   "roller and wall conditions act on `Faces` (the face gives the normal), "
                   "not on a region");
         b.components.assign(dim, true);
-        if (b.type == Description::Type::velocity)
+        if (b.type == Description::Type::velocity || b.type == Description::Type::displacement)
           {
             const auto list = s.get_list("Components");
             if (!(list.size() == 1 && list[0] == "all"))
@@ -288,8 +326,20 @@ namespace hysteron
                               (dim == 2 ? "x, y" : "x, y, z") + " or all)");
                   }
               }
-            b.velocity =
-              parse_vector_function<1>(s.get("Velocity"), dim, "t", false, s.where("Velocity"));
+            if (b.type == Description::Type::velocity)
+              b.velocity =
+                parse_vector_function<1>(s.get("Velocity"), dim, "t", false, s.where("Velocity"));
+            else
+              {
+                b.displacement = parse_vector_function<1>(
+                  s.get("Displacement"), dim, "t", false, s.where("Displacement"));
+                const auto u0 = evaluate_in_time<dim>(*b.displacement, 0.0);
+                for (unsigned int d = 0; d < dim; ++d)
+                  require(!b.components[d] || u0[d] == 0.0,
+                          s.where("Displacement"),
+                          std::string("must be 0 at t = 0 (component ") + coordinate_names[d] +
+                            " is " + std::to_string(u0[d]) + ")");
+              }
           }
         boundaries.push_back(std::move(b));
       }

@@ -111,6 +111,19 @@ namespace hysteron
                         Patterns::Anything(),
                         "Points whose history is written to probes.csv, as 'x,y; x,y' in 2D or "
                         "'x,y,z; ...' in 3D [m] (field methods only).");
+      prm.declare_entry("Probe interval",
+                        "0",
+                        Patterns::Double(),
+                        "Simulated time between rows of the probe, average, energy and reaction "
+                        "tables [s], >= 0; 0: every step (field methods).");
+      prm.declare_entry("Average regions",
+                        "",
+                        Patterns::Anything(),
+                        "Regions separated by ';' (doc/geometry.md); for each, average_<i>.csv "
+                        "holds the mass-weighted mean of the probe columns over the material "
+                        "(MPM: the points that started in the region; FEM: the quadrature points "
+                        "in it), e.g. a body's mean velocity or a section's mean stress, every "
+                        "`Probe interval` (field methods).");
       prm.declare_entry("Progress interval",
                         "2",
                         Patterns::Double(),
@@ -192,6 +205,12 @@ namespace hysteron
       output.write_vtu         = s.get_bool("Write VTU");
       output.probe_points      = parse_points<dim>(s.get("Probe points"), s.where("Probe points"));
       output.progress_interval = s.get_positive("Progress interval");
+      output.probe_interval    = s.get_non_negative("Probe interval");
+      for (const auto &expression :
+           dealii::Utilities::split_string_list(s.get("Average regions"), ';'))
+        if (!expression.empty())
+          output.average_regions.push_back(
+            Geometry::Region<dim>::parse(expression, s.where("Average regions")));
     }
 
     const SceneNames scene_names = SceneNames::read(prm);
@@ -282,6 +301,20 @@ namespace hysteron
     pcout << ".\nResults are in " << output.directory << "/" << std::endl;
     computing_timer.print_summary();
   }
+
+  namespace Methods
+  {
+    template <int dim>
+    std::string
+    Interface<dim>::output_directory() const
+    {
+      const std::string &directory = get_scene().output_control().directory;
+      return subdirectory.empty() ? directory : directory + "/" + subdirectory;
+    }
+
+    template class Interface<2>;
+    template class Interface<3>;
+  } // namespace Methods
 
   template class Scene<2>;
   template class Scene<3>;

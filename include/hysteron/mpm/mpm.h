@@ -9,6 +9,7 @@
 #include <hysteron/mpm/grid.h>
 #include <hysteron/mpm/particles.h>
 #include <hysteron/scene/method.h>
+#include <hysteron/scene/point_data.h>
 #include <hysteron/scene/scene.h>
 
 #include <cmath>
@@ -84,7 +85,6 @@ namespace hysteron
         std::vector<int>          normal_sign; ///< wall: +1 / -1 per node (lower / upper face)
         std::vector<unsigned int> normal_direction;
         std::vector<bool>         components;
-        const dealii::FunctionParser<1> *velocity = nullptr;
       };
 
       struct Probe
@@ -233,9 +233,7 @@ namespace hysteron
       unsigned int                                  current_group_key = 0;
       unsigned int                                  n_properties      = 0;
       std::vector<unsigned long>                    load_count; ///< points per load (index 0: none)
-      bool                                          energy_logged   = false;
-      double                                        initial_kinetic = 0;
-      double                                        initial_strain  = 0;
+      PointData::EnergyLog                          energy_log;
       dealii::types::particle_index                 n_global_particles = 0;
     };
   } // namespace MPM

@@ -65,8 +65,9 @@ namespace hysteron
     {
       fixed,    ///< every velocity component zero
       roller,   ///< the normal component zero (faces only)
-      wall,     ///< rigid frictionless wall: the normal component may not point into the wall
-      velocity  ///< the selected components follow functions of t
+      wall,         ///< rigid frictionless wall: the normal component may not point into the wall
+      velocity,     ///< the selected components of the velocity follow functions of t
+      displacement  ///< the selected components of the displacement follow functions of t
     };
     std::string                                name;
     Type                                       type = Type::fixed;
@@ -74,8 +75,22 @@ namespace hysteron
     std::vector<unsigned int>                  faces;
     Geometry::Region<dim>                      region; ///< used if has_region
     bool                                       has_region = false;
-    std::vector<bool>                          components; ///< velocity type: prescribed components
-    std::shared_ptr<dealii::FunctionParser<1>> velocity;   ///< velocity type: of t
+    std::vector<bool> components; ///< velocity/displacement types: prescribed components
+    std::shared_ptr<dealii::FunctionParser<1>> velocity;     ///< velocity type: of t
+    std::shared_ptr<dealii::FunctionParser<1>> displacement; ///< displacement type: of t, u(0) = 0
+
+    /**
+     * velocity and displacement types, for explicit steps: the velocity v(t)
+     * of a velocity type; for a displacement type the mean velocity of the step
+     * that ends at t, (u(t) - u(max(t - dt, 0))) / dt, so that x += dt v moves the
+     * nodes exactly along u(t).
+     */
+    dealii::Tensor<1, dim>
+    step_velocity(const double t, const double dt) const;
+
+    /// velocity and displacement types: u(t1) - u(t0) (a velocity is integrated by 3-point Gauss).
+    dealii::Tensor<1, dim>
+    displacement_increment(const double t0, const double t1) const;
 
     /// "x-", "y+", ... for face f.
     static std::string

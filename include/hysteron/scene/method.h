@@ -50,6 +50,28 @@ namespace hysteron
         return "";
       }
 
+      /**
+       * Write into the subdirectory @p name of `Output/Directory` instead of the
+       * directory itself (the compare method runs several methods in one scene).
+       * Call before run(); the subdirectory is created by run().
+       */
+      void
+      set_output_subdirectory(const std::string &name)
+      {
+        subdirectory = name;
+      }
+
+      /// The directory this method writes into.
+      std::string
+      output_directory() const;
+
+      /// "<output_directory()>/<file>".
+      std::string
+      output_file(const std::string &file) const
+      {
+        return output_directory() + "/" + file;
+      }
+
     protected:
       virtual void
       parse_parameters(dealii::ParameterHandler &prm) = 0;
@@ -62,6 +84,7 @@ namespace hysteron
 
     private:
       const Scene<dim> *scene_ptr = nullptr;
+      std::string       subdirectory;
     };
 
     template <int dim>

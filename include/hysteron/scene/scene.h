@@ -41,6 +41,8 @@ namespace hysteron
     bool                     write_vtu = true;
     std::vector<dealii::Point<dim>> probe_points;
     double                   progress_interval = 2.0; ///< wall seconds between progress lines
+    double                   probe_interval    = 0.0; ///< simulated seconds between table rows
+    std::vector<Geometry::Region<dim>> average_regions;
   };
 
   /// How the executable was called.
