@@ -129,6 +129,69 @@ namespace hysteron
       /// The maximal depth of the evaluation stack (limits nesting).
       static constexpr unsigned int max_stack_depth = 64;
 
+      /**
+       * @name Read access for mesh generators (see Geometry::structured_mesh() and
+       * Geometry::unstructured_mesh() in hysteron/geometry/mesh.h)
+       * @{
+       */
+
+      /// The primitives, in the order they appear in the expression.
+      const std::vector<Primitive> &
+      get_primitives() const;
+
+      /// The postfix program over get_primitives() that contains() evaluates.
+      const std::vector<Instruction> &
+      get_program() const;
+
+      /// The vertices of a polygon primitive of this region, in the order given.
+      std::vector<dealii::Point<2>>
+      polygon_vertices(const Primitive &polygon) const;
+
+      /**
+       * The number of sides of the regular polygon that stands for a disk of
+       * radius @p radius at resolution @p h: n = max(16, ceil(2 pi r / h)),
+       * rounded up to a multiple of 4 (so that the 4 axis points are vertices).
+       * Every side is at most 2 pi r / n <= h long. Requires h > 0.
+       */
+      static unsigned int
+      n_disk_sides(const double radius, const double h);
+
+      /**
+       * The vertices of that regular polygon, counter-clockwise, the first one at
+       * (cx + r, cy): vertex j is the centre plus r (cos, sin)(2 pi j / n),
+       * evaluated for the first quarter and rotated by multiples of 90 degrees
+       * exactly, so the axis points are exactly cx +- r, cy +- r and the polygon
+       * lies inside the disk. polygonized() and boundary_segments() use exactly
+       * these points.
+       */
+      static std::vector<dealii::Point<2>>
+      disk_polygon(const dealii::Point<2> &centre, const double radius, const double h);
+
+      /**
+       * 2D only: the same expression with every disk replaced by its
+       * disk_polygon() at resolution @p h (bit for bit the same vertices), so that
+       * contains() agrees with a mesh whose boundary is made of those polygons.
+       * expression() returns the original expression; bounding_box() is unchanged
+       * (the polygon's extreme points are the disk's axis points). Throws
+       * dealii::ExcNotImplemented in 3D.
+       */
+      Region<2>
+      polygonized(const double h) const;
+
+      /**
+       * 2D only: the boundary of every primitive as straight segments: the 4
+       * sides of a rectangle, the sides of a polygon, and the sides of a disk's
+       * disk_polygon() at resolution @p h; nothing for `all`. The segments of
+       * subtracted primitives are included (they bound the region too), in the
+       * order of the primitives; each closed loop is traversed counter-clockwise
+       * for rectangles and disks, in the order given for polygons. Throws
+       * dealii::ExcNotImplemented in 3D.
+       */
+      std::vector<std::array<dealii::Point<2>, 2>>
+      boundary_segments(const double h) const;
+
+      /** @} */
+
     private:
       bool
       primitive_contains(const Primitive        &primitive,
@@ -142,6 +205,9 @@ namespace hysteron
       std::vector<Instruction>      program;
       dealii::BoundingBox<dim>      box;
       struct Parser;
+
+      template <int>
+      friend class Region;
     };
 
     /**

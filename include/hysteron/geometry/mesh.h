@@ -1,0 +1,133 @@
+#ifndef hysteron_geometry_mesh_h
+#define hysteron_geometry_mesh_h
+
+#include <deal.II/base/point.h>
+
+#include <deal.II/grid/tria_description.h>
+
+#include <hysteron/geometry/region.h>
+
+#include <string>
+#include <vector>
+
+namespace hysteron
+{
+  namespace Geometry
+  {
+    /**
+     * A coarse mesh ready for
+     * `Triangulation::create_triangulation(vertices, cells, SubCellData())`:
+     * quadrilaterals (2D) / hexahedra (3D) in deal.II's vertex order
+     * (lexicographic: 0 = (0,0), 1 = (1,0), 2 = (0,1), 3 = (1,1), and in 3D the
+     * same square again at z = 1), every cell positively oriented and the lines
+     * consistently oriented (so a parallel::distributed::Triangulation accepts
+     * it), material_id = index of the body (in the order given) that contains the
+     * cell's centre. Every vertex is used by some cell. See doc/geometry.md,
+     * "Meshes for the FEM".
+     */
+    template <int dim>
+    struct CoarseMesh
+    {
+      std::vector<dealii::Point<dim>>    vertices;
+      std::vector<dealii::CellData<dim>> cells;
+
+      /// Sum of the cell measures (m^dim); exact for these straight-sided cells.
+      double
+      volume() const;
+    };
+
+    /**
+     * Whether every primitive of @p region is an axis-aligned rectangle/box (or
+     * `all`): then structured_mesh() represents it exactly.
+     */
+    template <int dim>
+    bool
+    is_rectilinear(const Region<dim> &region);
+
+    /**
+     * A tensor-product ("rectilinear") mesh of the bounding box of all bodies.
+     *
+     * Along each axis the breakpoints are the two ends of the box and every
+     * coordinate of every rectangle/box primitive of the bodies (added or
+     * subtracted) inside the box; breakpoints closer than 1e-12 times the box
+     * size are merged. Each interval between consecutive breakpoints of length L
+     * is split uniformly into max(1, ceil(L / h)) cells (a relative slack of 1e-9
+     * absorbs round-off, so 0.1 / 0.025 gives 4 cells). A cell of the tensor grid
+     * is kept if its centre lies in a body; the first body that contains it gives
+     * its material_id. Vertices that no kept cell uses are dropped; the others
+     * are numbered lexicographically (x fastest), the cells likewise.
+     *
+     * Exact for rectilinear bodies (is_rectilinear()): every face of every box
+     * lies on grid planes. Otherwise a staircase approximation (the caller can
+     * compare volume() with the expected volume). Interfaces between touching
+     * bodies are conforming by construction. Short intervals give thin cells
+     * through the whole grid (tensor product): a flange of thickness t < h makes
+     * a layer of cells of height t across the box.
+     *
+     * Throws InputError(@p where, ...) for h <= 0, no body, a null, empty or
+     * unbounded body, a tensor grid of more than 5e6 cells, or if a body (or the
+     * union) gets no cell.
+     */
+    template <int dim>
+    CoarseMesh<dim>
+    structured_mesh(const std::vector<const Region<dim> *> &bodies,
+                    const double                             h,
+                    const std::string                       &where);
+
+    /**
+     * 2D only: an unstructured, body-fitted quadrilateral mesh.
+     *
+     * 1. The boundaries of all primitives of all bodies (rectangle sides, polygon
+     *    sides, disks as the regular polygons of Region::disk_polygon(), n =
+     *    max(16, ceil(2 pi r / h)) sides rounded up to a multiple of 4), clipped
+     *    to the bounding box of the bodies, are inserted as constraints into one
+     *    CGAL constrained Delaunay triangulation (exact predicates, exactly
+     *    computed and rounded intersections: crossing and overlapping constraints
+     *    are allowed).
+     * 2. Every triangle whose centroid lies (within 1e-6 h) in a body is marked as
+     *    the domain, and the domain is refined by CGAL::Delaunay_mesher_2 with
+     *    Delaunay_mesh_size_criteria_2(0.125, h): every edge of a domain triangle
+     *    is at most h long and, away from input angles below 60 degrees, every
+     *    angle is at least arcsin(sqrt(0.125)) = 20.7 degrees.
+     * 3. A refined triangle is kept if its centroid lies in a body's polygonized()
+     *    region (first body wins: material_id); since the constraints are mesh
+     *    edges, each triangle lies on one side of every primitive's boundary, and
+     *    its centroid is well away from all of them: the classification agrees
+     *    with the mesh boundary.
+     * 4. Each kept triangle is split into three quadrilaterals (vertex, two edge
+     *    midpoints, centroid; midpoints of shared edges shared). The quads are
+     *    convex; their edges are at most h/2 long; their angles are at least the
+     *    triangle's smallest angle (>= 20.7 degrees, where CGAL guarantees it) and
+     *    at most about 166 degrees.
+     *
+     * The triangles are ordered along a Hilbert curve through their centroids
+     * (contiguous p4est partitions), vertices are numbered in order of first use;
+     * the result depends on the input only (every MPI rank builds the same mesh).
+     * Cells are oriented counter-clockwise, and their lines are consistently
+     * oriented by construction (every line runs from a triangle vertex to an edge
+     * midpoint or from a midpoint to a centroid; vertex 0 of each quad is the
+     * triangle vertex, vertex 3 the centroid), so
+     * dealii::GridTools::consistently_order_cells() is not needed.
+     *
+     * The mesh represents the polygonized bodies exactly: volume() equals the
+     * area of Region::polygonized(h) up to round-off. About 15 area / h^2 quads
+     * (measured; 5 triangles per h^2): the quads are about h/3 in size, so this
+     * mesh is much finer than structured_mesh() at the same h. Features smaller
+     * than h (nearly touching primitives, tangencies) are resolved by graded local
+     * refinement.
+     *
+     * Throws InputError(@p where, ...) for h <= 0, no body, a null, empty or
+     * unbounded body, a disk needing more than 1e6 sides, an estimated mesh of
+     * more than 5e6 cells (estimated from the bounding boxes), a refinement that
+     * needs more than max(1e5, 2 x estimated cells) vertices (e.g. a sliver 1e-9
+     * wide along a side, where overlapping bodies nearly coincide), or if a body
+     * (or the union) gets no cell.
+     */
+    CoarseMesh<2>
+    unstructured_mesh(const std::vector<const Region<2> *> &bodies,
+                      const double                           h,
+                      const std::string                     &where);
+  } // namespace Geometry
+} // namespace hysteron
+
+#endif
