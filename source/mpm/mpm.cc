@@ -671,8 +671,8 @@ namespace hysteron
           const auto            &bc   = boundaries[b];
           const Type             type = static_cast<Type>(bc.type);
           dealii::Tensor<1, dim> prescribed;
-          if (type == Type::velocity || type == Type::displacement)
-            prescribed = scene_boundaries[b].step_velocity(t, dt);
+          if (type == Type::velocity)
+            prescribed = scene_boundaries[b].step_velocity(t, dt, dealii::Point<dim>());
           for (unsigned int k = 0; k < bc.nodes.size(); ++k)
             {
               const unsigned int n = bc.nodes[k];
@@ -686,8 +686,11 @@ namespace hysteron
                     for (unsigned int c = 0; c < dim; ++c)
                       impose(r, c, 0.0, n, reactions[b]);
                     break;
-                  case Type::velocity:
                   case Type::displacement:
+                    // u may depend on the node's position: its mean velocity over the step.
+                    prescribed = scene_boundaries[b].step_velocity(t, dt, grid->node_position(n));
+                    [[fallthrough]];
+                  case Type::velocity:
                     for (unsigned int c = 0; c < dim; ++c)
                       if (bc.components[c])
                         impose(r, c, prescribed[c], n, reactions[b]);

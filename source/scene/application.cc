@@ -22,7 +22,7 @@ namespace hysteron
   namespace
   {
     const char *usage_text =
-      "Usage: hysteron [--quiet] SCENE.prm\n"
+      "Usage: hysteron [--quiet] [--compare] SCENE.prm\n"
       "       hysteron --print-parameters [prm|json|markdown] [SCENE.prm]\n"
       "       hysteron --help | --version\n"
       "\n"
@@ -31,6 +31,8 @@ namespace hysteron
       "\n"
       "Options:\n"
       "  --quiet              no progress, summary or timer table on stdout\n"
+      "  --compare            run the scene with two methods (Compare/Methods, default mpm\n"
+      "                       and fem) and compare their tables (= set Method = compare)\n"
       "  --print-parameters   write every parameter with its default, allowed values and\n"
       "                       documentation (PRM, JSON or Markdown) and exit; with SCENE.prm,\n"
       "                       the values of that file and its named materials\n"
@@ -127,6 +129,7 @@ namespace hysteron
     {
       RunOptions  options;
       bool        print_parameters = false;
+      bool        compare          = false;
       std::string format           = "prm";
       std::vector<std::string> files;
       for (int i = 1; i < argc; ++i)
@@ -146,6 +149,8 @@ namespace hysteron
             }
           else if (arg == "--quiet" || arg == "-q")
             options.quiet = true;
+          else if (arg == "--compare")
+            compare = true;
           else if (arg == "--print-parameters")
             {
               print_parameters = true;
@@ -201,6 +206,9 @@ namespace hysteron
           {
             throw InputError(files[0], one_line(e));
           }
+
+      if (compare)
+        prm.set("Method", "compare");
 
       if (print_parameters)
         {

@@ -44,6 +44,18 @@ namespace hysteron
 
   template <int dim>
   dealii::Tensor<1, dim>
+  integrate_in_time(const dealii::FunctionParser<1> &f, const double t0, const double t1)
+  {
+    const double m = 0.5 * (t0 + t1), r = 0.5 * (t1 - t0), a = std::sqrt(0.6);
+    return r * ((5.0 / 9.0) * evaluate_in_time<dim>(f, m - a * r) +
+                (8.0 / 9.0) * evaluate_in_time<dim>(f, m) +
+                (5.0 / 9.0) * evaluate_in_time<dim>(f, m + a * r));
+  }
+
+
+
+  template <int dim>
+  dealii::Tensor<1, dim>
   BodyDescription<dim>::velocity_at(const dealii::Point<dim> &p) const
   {
     dealii::Tensor<1, dim> v;
@@ -62,28 +74,34 @@ namespace hysteron
 
   template <int dim>
   dealii::Tensor<1, dim>
-  BoundaryDescription<dim>::displacement_increment(const double t0, const double t1) const
+  BoundaryDescription<dim>::displacement_increment(const double              t0,
+                                                   const double              t1,
+                                                   const dealii::Point<dim> &x) const
   {
-    if (displacement)
-      return evaluate_in_time<dim>(*displacement, t1) - evaluate_in_time<dim>(*displacement, t0);
-    // 3-point Gauss-Legendre on [t0, t1]: exact for velocities of degree 5 in t.
-    const double           m = 0.5 * (t0 + t1), r = 0.5 * (t1 - t0), a = std::sqrt(0.6);
-    dealii::Tensor<1, dim> u = (5.0 / 9.0) * evaluate_in_time<dim>(*velocity, m - a * r) +
-                               (8.0 / 9.0) * evaluate_in_time<dim>(*velocity, m) +
-                               (5.0 / 9.0) * evaluate_in_time<dim>(*velocity, m + a * r);
-    return r * u;
+    if (!displacement)
+      return integrate_in_time<dim>(*velocity, t0, t1);
+    dealii::Tensor<1, dim> u;
+    displacement->set_time(t1);
+    for (unsigned int d = 0; d < dim; ++d)
+      u[d] = displacement->value(x, d);
+    displacement->set_time(t0);
+    for (unsigned int d = 0; d < dim; ++d)
+      u[d] -= displacement->value(x, d);
+    return u;
   }
 
 
 
   template <int dim>
   dealii::Tensor<1, dim>
-  BoundaryDescription<dim>::step_velocity(const double t, const double dt) const
+  BoundaryDescription<dim>::step_velocity(const double              t,
+                                          const double              dt,
+                                          const dealii::Point<dim> &x) const
   {
     if (velocity)
       return evaluate_in_time<dim>(*velocity, t);
     Assert(dt > 0, dealii::ExcMessage("a displacement needs the step length"));
-    return displacement_increment(std::max(t - dt, 0.0), t) / dt;
+    return displacement_increment(std::max(t - dt, 0.0), t, x) / dt;
   }
 
 
@@ -200,9 +218,9 @@ namespace hysteron
         prm.declare_entry("Displacement",
                           "",
                           Patterns::Anything(),
-                          "displacement type: the displacement [m] from the initial position as "
-                          "functions of t, one per space direction separated by ';'; must vanish "
-                          "at t = 0 (entries of free components are unused).");
+                          "displacement type: the displacement [m] as functions of x, y (, z) and "
+                          "t, one per space direction separated by ';' (entries of free components "
+                          "are unused); a node at x moves by u(x, t) - u(x, 0).");
         prm.leave_subsection();
       }
     for (const auto &name : names.loads)
@@ -330,16 +348,11 @@ namespace hysteron
               b.velocity =
                 parse_vector_function<1>(s.get("Velocity"), dim, "t", false, s.where("Velocity"));
             else
-              {
-                b.displacement = parse_vector_function<1>(
-                  s.get("Displacement"), dim, "t", false, s.where("Displacement"));
-                const auto u0 = evaluate_in_time<dim>(*b.displacement, 0.0);
-                for (unsigned int d = 0; d < dim; ++d)
-                  require(!b.components[d] || u0[d] == 0.0,
-                          s.where("Displacement"),
-                          std::string("must be 0 at t = 0 (component ") + coordinate_names[d] +
-                            " is " + std::to_string(u0[d]) + ")");
-              }
+              b.displacement = parse_vector_function<dim>(s.get("Displacement"),
+                                                          dim,
+                                                          space_variables<dim>() + ",t",
+                                                          true,
+                                                          s.where("Displacement"));
           }
         boundaries.push_back(std::move(b));
       }
@@ -380,7 +393,10 @@ namespace hysteron
                                                               const SceneNames &);              \
   template dealii::Tensor<1, dim> parse_vector<dim>(const std::string &, const std::string &);  \
   template dealii::Tensor<1, dim> evaluate_in_time<dim>(const dealii::FunctionParser<1> &,      \
-                                                        double);
+                                                        double);                               \
+  template dealii::Tensor<1, dim> integrate_in_time<dim>(const dealii::FunctionParser<1> &,     \
+                                                         double,                               \
+                                                         double);
 
   HYSTERON_INSTANTIATE(2)
   HYSTERON_INSTANTIATE(3)

@@ -84,6 +84,13 @@ namespace hysteron
                    double                                &eps_zz,
                    double                                &sigma_zz) const override;
 
+      /// The backward Euler integrator returns the algorithmic tangent; the explicit ones E_t.
+      bool
+      has_consistent_tangent() const override
+      {
+        return parameters.integrator == BoucWenIntegrator::backward_euler;
+      }
+
       const BoucWenParameters &
       get_parameters() const
       {

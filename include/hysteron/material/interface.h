@@ -118,6 +118,17 @@ namespace hysteron
                    double                                &eps_zz,
                    double                                &sigma_zz) const;
 
+      /**
+       * Whether the tangents of update() are the consistent (algorithmic)
+       * derivatives of the updated stress, so that a Newton solver converges
+       * quadratically (default: true; Bouc-Wen only with `backward euler`).
+       */
+      virtual bool
+      has_consistent_tangent() const
+      {
+        return true;
+      }
+
       /// Warnings found while reading the parameters (printed by the scene on rank 0).
       const std::vector<std::string> &
       warnings() const

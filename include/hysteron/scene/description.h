@@ -77,20 +77,22 @@ namespace hysteron
     bool                                       has_region = false;
     std::vector<bool> components; ///< velocity/displacement types: prescribed components
     std::shared_ptr<dealii::FunctionParser<1>> velocity;     ///< velocity type: of t
-    std::shared_ptr<dealii::FunctionParser<1>> displacement; ///< displacement type: of t, u(0) = 0
+    /// displacement type: of x, y (, z), t; u(x, t) - u(x, 0) is prescribed
+    std::shared_ptr<dealii::FunctionParser<dim>> displacement;
 
     /**
      * velocity and displacement types, for explicit steps: the velocity v(t)
      * of a velocity type; for a displacement type the mean velocity of the step
-     * that ends at t, (u(t) - u(max(t - dt, 0))) / dt, so that x += dt v moves the
-     * nodes exactly along u(t).
+     * that ends at t at the node @p x, (u(x, t) - u(x, max(t - dt, 0))) / dt, so that
+     * x += dt v moves the node exactly along u.
      */
     dealii::Tensor<1, dim>
-    step_velocity(const double t, const double dt) const;
+    step_velocity(const double t, const double dt, const dealii::Point<dim> &x) const;
 
-    /// velocity and displacement types: u(t1) - u(t0) (a velocity is integrated by 3-point Gauss).
+    /// velocity and displacement types: u(x, t1) - u(x, t0) (a velocity is integrated by
+    /// 3-point Gauss and does not depend on x).
     dealii::Tensor<1, dim>
-    displacement_increment(const double t0, const double t1) const;
+    displacement_increment(const double t0, const double t1, const dealii::Point<dim> &x) const;
 
     /// "x-", "y+", ... for face f.
     static std::string
@@ -143,6 +145,12 @@ namespace hysteron
   template <int dim>
   dealii::Tensor<1, dim>
   evaluate_in_time(const dealii::FunctionParser<1> &f, const double t);
+
+  /// The integral of a vector function of t over [t0, t1] by 3-point Gauss-Legendre
+  /// (exact for polynomials of degree 5; a velocity's displacement increment).
+  template <int dim>
+  dealii::Tensor<1, dim>
+  integrate_in_time(const dealii::FunctionParser<1> &f, const double t0, const double t1);
 } // namespace hysteron
 
 #endif

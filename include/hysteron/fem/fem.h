@@ -1,0 +1,360 @@
+#ifndef hysteron_fem_fem_h
+#define hysteron_fem_fem_h
+
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/base/quadrature_point_data.h>
+#include <deal.II/distributed/tria.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/mapping_q.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+
+#include <hysteron/base/output.h>
+#include <hysteron/geometry/region.h>
+#include <hysteron/scene/method.h>
+#include <hysteron/scene/point_data.h>
+#include <hysteron/scene/scene.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace hysteron
+{
+  /**
+   * The hysteretic finite element method (`set Method = fem`): the scene's
+   * bodies meshed with quadrilaterals / hexahedra, FESystem(FE_Q(p), dim) with
+   * p = 1 or 2, any registered material at the quadrature points, and three
+   * analyses: quasi-static (load or displacement control in increments),
+   * implicit dynamics (Newmark / HHT-alpha) and explicit dynamics (central
+   * differences with a lumped mass, the MPM's setting). See doc/fem.md.
+   */
+  namespace FEM
+  {
+    enum class Analysis
+    {
+      quasi_static,      ///< equilibrium f_int(u) = f_ext(t) at each increment (Newton)
+      implicit_dynamics, ///< Newmark / HHT-alpha with Newton
+      explicit_dynamics  ///< central differences, lumped mass
+    };
+
+    enum class LinearSolver
+    {
+      automatic, ///< direct up to `Direct solver limit` DoFs, else CG (symmetric) or GMRES
+      direct,    ///< Trilinos Amesos (KLU)
+      cg,        ///< CG with ML algebraic multigrid (symmetric tangents)
+      gmres      ///< GMRES with ML algebraic multigrid
+    };
+
+    /**
+     * The quadrature-point data of one locally owned cell (one object per cell
+     * in a CellDataStorage): the converged stress, strain and material state at
+     * the end of the last step, and the trial values of the current Newton
+     * iterate (recomputed from the converged ones at every evaluation, so the
+     * path-dependent material only ever sees increments from a converged state).
+     * Arrays are per quadrature point, contiguous, so that one material update
+     * call serves the whole cell.
+     */
+    template <int dim>
+    struct CellHistory
+    {
+      const Material::Interface<dim>              *material  = nullptr;
+      unsigned int                                 body      = 0;
+      unsigned int                                 n_state   = 0;
+      double                                       thickness = 1; ///< 2D: out-of-plane [m]
+      std::vector<dealii::SymmetricTensor<2, dim>> stress, strain;  ///< converged
+      std::vector<double>                          state;           ///< converged, n_q x n_state
+      std::vector<dealii::SymmetricTensor<2, dim>> trial_stress, increment;
+      std::vector<double>                          trial_state;
+      std::vector<dealii::SymmetricTensor<4, dim>> tangent;
+      std::vector<double>                          weight; ///< JxW times the thickness
+      std::vector<dealii::Point<dim>>              point;  ///< quadrature points (reference configuration)
+    };
+
+    /// See the namespace documentation.
+    template <int dim>
+    class Solver : public Methods::Interface<dim>
+    {
+    public:
+      Solver();
+      ~Solver() override;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+
+      void
+      run() override;
+
+      std::string
+      summary() const override;
+
+    protected:
+      void
+      parse_parameters(dealii::ParameterHandler &prm) override;
+
+    private:
+      using Vector = dealii::TrilinosWrappers::MPI::Vector;
+      using Matrix = dealii::TrilinosWrappers::SparseMatrix;
+
+      /// What an evaluation of the discrete equations assembles.
+      enum class Assemble
+      {
+        forces,  ///< f_int, f_ext and the residual
+        residual_and_matrix ///< ... and the (effective) tangent matrix
+      };
+
+      /// A Dirichlet condition on DoFs: a scene boundary (index b) or a rigid body.
+      struct DirichletSet
+      {
+        std::string                                 name;
+        int                                         boundary = -1; ///< scene boundary, or -1
+        int                                         rigid    = -1; ///< scene body, or -1
+        std::vector<dealii::types::global_dof_index> dofs;         ///< locally relevant
+        std::vector<unsigned int>                   components;   ///< of each dof
+      };
+
+      /// A load and how it acts on the mesh (see setup_loads()).
+      struct LoadSet
+      {
+        enum class Kind
+        {
+          volume,  ///< a total force spread uniformly over the material in the region
+          nodal,   ///< a total force shared evenly by the nodes in the region
+          traction ///< a force per area on the boundary faces in the region
+        };
+        unsigned int load  = 0;   ///< index in the scene's loads
+        Kind         kind  = Kind::volume;
+        double       scale = 0;   ///< volume: 1 / selected volume; nodal: 1 / nodes; traction: 1
+        std::vector<dealii::types::global_dof_index> nodal_dofs; ///< owned, with components
+        std::vector<unsigned int>                   nodal_components;
+      };
+
+      struct Probe
+      {
+        dealii::Point<dim> point;
+        int                owner = -1; ///< rank that evaluates it
+        // The nearest quadrature point (on the owner): cell and index.
+        typename dealii::Triangulation<dim>::active_cell_iterator cell;
+        unsigned int                                              q = 0;
+        dealii::Point<dim>                                        q_point;
+        // The cell containing the point and its reference coordinates (owner).
+        typename dealii::DoFHandler<dim>::active_cell_iterator dof_cell;
+        dealii::Point<dim>                                     reference;
+        bool has_cell = false; ///< this rank evaluates the displacement at the point
+        bool has_q    = false; ///< this rank owns the nearest quadrature point
+      };
+
+      // Parameters.
+      unsigned int  degree       = 1;
+      Analysis      analysis     = Analysis::quasi_static;
+      double        fem_time_step = 0;
+      unsigned int  n_increments = 100;
+      double        maximum_cfl  = 1;
+      std::string   generator    = "automatic";
+      double        cell_size    = 0;
+      unsigned int  refinements  = 0;
+      std::string   mesh_file;
+      double        newton_tolerance = 1e-8;
+      unsigned int  newton_max_iterations = 25;
+      bool          line_search = true;
+      unsigned int  max_cuts   = 8;
+      double        hht_alpha  = 0;
+      double        rayleigh_mass = 0, rayleigh_stiffness = 0;
+      LinearSolver  solver_type = LinearSolver::automatic;
+      unsigned long direct_limit = 100000;
+      double        solver_tolerance = 1e-10;
+      unsigned int  solver_max_iterations = 5000;
+      bool          quadrature_table = false;
+
+      // Set-up.
+      void
+      make_mesh();
+      void
+      setup_system();
+      void
+      setup_history();
+      void
+      setup_dirichlet();
+      void
+      setup_loads();
+      void
+      setup_probes();
+      void
+      setup_dynamics();
+
+      /**
+       * The constraints of a step to time @p t1: every prescribed DoF gets the
+       * increment of its prescribed displacement from the converged state
+       * (@p predictor) or 0 (later Newton iterations).
+       */
+      void
+      make_constraints(const double t1, const bool predictor);
+
+      /**
+       * Evaluate the discrete equations at the iterate @p u_iterate (ghosted) of
+       * the step from the converged state (u_n at t_n) to t1: material updates at
+       * every quadrature point (trial state), f_int, f_ext(t1), and into
+       * system_rhs (condensed, = -residual) and, on request, system_matrix.
+       * Returns false (on every rank) if a material update failed; the message
+       * is in material_failure.
+       */
+      bool
+      assemble(const Vector  &u_iterate,
+               const double   t1,
+               const double   dt,
+               const Assemble what,
+               const bool     update_material = true);
+
+      /// The mass system of the initial acceleration M a0 = f_ext(0) - f_int(0) - C v0.
+      void
+      assemble_mass_system();
+
+      /// y = K0 x (elastic stiffness, matrix-free); @p x ghosted.
+      void
+      elastic_stiffness_product(const Vector &x, Vector &y) const;
+
+      /// force += factor C v (Rayleigh damping with the lumped mass, explicit dynamics).
+      void
+      damping_force(const Vector &velocity, Vector &force, const double factor) const;
+
+      /// The prescribed displacement increment of constrained DoF @p k (constrained_list) over [t0, t1].
+      double
+      prescribed_increment(const unsigned int k, const double t0, const double t1) const;
+
+      /// The prescribed velocity of constrained DoF @p k at t (displacement: the mean of the step ending at t).
+      double
+      prescribed_velocity(const unsigned int k, const double t, const double dt) const;
+
+      /// Whether x lies in the region of load set @p l.
+      bool
+      in_region(const unsigned int l, const dealii::Point<dim> &x) const
+      {
+        return load_regions[l]->contains(x, 1e-9 * u_scale);
+      }
+
+      /// The force level of the last evaluation that Newton's tolerance refers to.
+      double
+      force_level() const
+      {
+        return std::max(last_force_level, 1e-3 * force_scale);
+      }
+
+      /// A row of newton.csv.
+      void
+      log_newton(const double       t1,
+                 const double       dt,
+                 const unsigned int iteration,
+                 const double       residual,
+                 const double       alpha);
+
+      /// Solve system_matrix du = system_rhs; returns the iterations (0 for direct).
+      unsigned int
+      solve_linear(Vector &du);
+
+      /// One implicit step (quasi-static or Newmark) from t to t + dt; false if Newton failed.
+      bool
+      implicit_step(const double t, const double dt);
+
+      /// One explicit central-difference step from t to t + dt.
+      void
+      explicit_step(const double t, const double dt);
+
+      /// Accept the trial state as converged (stresses, states, strains, work, vectors).
+      void
+      commit(const double t1, const double dt);
+
+      /// The critical step of central differences, 2 / omega_max (power iteration).
+      double
+      critical_time_step();
+
+      // Output.
+      void
+      open_tables();
+      void
+      write_table_rows(const double t);
+      void
+      write_fields(const double t);
+      void
+      write_quadrature_table() const;
+      void
+      commit_tables();
+      [[noreturn]] void
+      fail(const std::string &what, const double t);
+
+      /// The reaction (force of the constraint on the body) of every Dirichlet set.
+      std::vector<dealii::Tensor<1, dim>>
+      reactions() const;
+
+      // The discretisation.
+      dealii::parallel::distributed::Triangulation<dim> triangulation;
+      std::unique_ptr<dealii::FESystem<dim>>            fe;
+      dealii::MappingQ<dim>                             mapping;
+      dealii::DoFHandler<dim>                           dof_handler;
+      std::unique_ptr<dealii::QGauss<dim>>              quadrature;
+      std::unique_ptr<dealii::QGauss<dim - 1>>          face_quadrature;
+      dealii::IndexSet                                  owned_dofs, relevant_dofs;
+      dealii::AffineConstraints<double>                 constraints;
+      Matrix                                            system_matrix;
+      Vector                                            system_rhs;
+      dealii::CellDataStorage<typename dealii::Triangulation<dim>::cell_iterator, CellHistory<dim>>
+        history;
+      std::vector<const Material::Interface<dim> *> body_material;
+      std::vector<unsigned int>                     body_to_mesh; ///< scene body -> material id
+      std::vector<unsigned int>                     mesh_to_body;
+      std::vector<std::string>                      state_names;
+      bool                                          symmetric_tangent = true;
+      bool                                          consistent_tangent = true;
+
+      // Prescribed motion and loads.
+      std::vector<DirichletSet>             dirichlet;
+      std::vector<dealii::types::global_dof_index> constrained_list; ///< relevant, all sets
+      std::vector<int>                      constrained_set;  ///< set of each listed dof
+      std::vector<unsigned int>             constrained_component;
+      std::vector<dealii::Point<dim>>       constrained_point; ///< support point of each listed dof
+      std::vector<LoadSet>                  load_sets;
+      std::vector<const Geometry::Region<dim> *> load_regions;
+      std::vector<bool>                     cell_in_load; ///< per (active cell index, load set)
+      std::vector<dealii::Point<dim>>       owned_support;   ///< support point of each owned DoF
+      std::vector<unsigned int>             owned_component; ///< component of each owned DoF
+      /// Wall conditions (explicit dynamics): per wall, the normal direction, side and position.
+      struct Wall
+      {
+        unsigned int set = 0, direction = 0;
+        bool         lower = true;
+        double       position = 0;
+      };
+      std::vector<Wall>                     walls;
+      std::vector<dealii::types::global_dof_index> wall_dofs; ///< owned dofs of normal components
+      std::vector<double>                   wall_reference;  ///< their reference coordinate
+      std::vector<unsigned int>             wall_of_dof;
+      std::vector<dealii::Tensor<1, dim>>   wall_forces;     ///< per Dirichlet set, last step
+
+      // The state: displacement, velocity, acceleration (owned and ghosted), the
+      // converged forces, and the lumped mass of explicit dynamics.
+      Vector u, u_ghost, v, v_ghost, a, a_ghost, u_trial;
+      Vector f_int, f_ext, f_int_old, f_ext_old, inertia, lumped_mass, reaction_old;
+      dealii::BoundingBox<dim> mesh_box;
+      double                   u_scale = 0;    ///< characteristic length for tolerances [m]
+      double                   force_scale = 0; ///< largest force norm seen (Newton floor)
+      double                   last_force_level = 0;
+      double                   current_dt = 0;  ///< the step being solved
+
+      // Diagnostics and bookkeeping.
+      std::string                                      material_failure;
+      std::vector<Probe>                               probes;
+      std::unique_ptr<Output::FieldWriter>             field_writer;
+      std::vector<std::unique_ptr<Output::CsvWriter>>  probe_tables, average_tables;
+      std::unique_ptr<Output::CsvWriter>               energy_table, reaction_table, newton_table;
+      PointData::EnergyLog                             energy_log;
+      double internal_work = 0, external_work = 0, boundary_work = 0;
+      unsigned long n_steps = 0, n_newton = 0, n_cuts = 0, n_linear = 0;
+      unsigned int  n_outputs = 0;
+      double        critical_step = 0;
+      std::string   solver_name;
+    };
+  } // namespace FEM
+} // namespace hysteron
+
+#endif

@@ -1,0 +1,400 @@
+#include <deal.II/base/exceptions.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/vector.h>
+
+#include <hysteron/fem/fem.h>
+
+#include <cmath>
+#include <sstream>
+
+namespace hysteron
+{
+  namespace FEM
+  {
+    /*
+     * The discrete equations. With N_i the vector shape functions, B_i their
+     * symmetric gradients, w_q = JxW_q t (t: the thickness in 2D) and the
+     * stresses sigma_q of the material update from the converged state,
+     *   f_int,i = sum_q B_i(x_q) : sigma_q w_q,
+     *   K_ij    = sum_q B_i : C_q : B_j w_q        (C_q: the material's tangent),
+     *   M_ij    = sum_q rho N_i . N_j w_q,   K0_ij = sum_q B_i : D : B_j w_q (elastic),
+     *   f_ext,i = sum_q N_i . (rho g + F_l(t) / V_l) w_q + sum_faces N_i . t_l(t) w_f,
+     * for body loads F_l (a total force spread over the volume V_l of the
+     * material in the load's region) and tractions t_l on the boundary faces in
+     * the region.
+     *
+     * Quasi-static: r = f_int(u) - f_ext(t1), tangent K.
+     * HHT-alpha (Newmark for alpha = 0), beta = (1 - alpha)^2 / 4, gamma = 1/2 - alpha:
+     *   a1 = (u1 - u0 - dt v0) / (beta dt^2) - (1 - 2 beta) / (2 beta) a0,
+     *   v1 = v0 + dt ((1 - gamma) a0 + gamma a1),
+     *   r  = M a1 + (1 + alpha)(C v1 + f_int(u1) - f_ext(t1)) - alpha (C v0 + f_int(u0) - f_ext(t0)),
+     *   dr/du1 = M / (beta dt^2) + (1 + alpha) gamma / (beta dt) C + (1 + alpha) K,
+     * with Rayleigh damping C = a0 M + a1 K0. Everything is formed cell by cell,
+     * so that AffineConstraints condenses the prescribed DoFs (and, in the
+     * predictor, moves the prescribed increments to the right-hand side).
+     */
+    template <int dim>
+    bool
+    Solver<dim>::assemble(const Vector  &u_iterate,
+                          const double   t1,
+                          const double   dt,
+                          const Assemble what,
+                          const bool     update_material)
+    {
+      using namespace dealii;
+      const Scene<dim> &scene   = this->get_scene();
+      const bool        matrix  = what == Assemble::residual_and_matrix;
+      // dt = 0: the forces of the state u_iterate only (the initial state).
+      const bool        dynamic = analysis == Analysis::implicit_dynamics && dt > 0;
+      const bool        system  = analysis != Analysis::explicit_dynamics;
+      const double      alpha = hht_alpha, beta = (1 - alpha) * (1 - alpha) / 4, gamma = 0.5 - alpha;
+      const double      t0 = t1 - dt;
+
+      if (matrix)
+        system_matrix = 0;
+      if (system)
+        system_rhs = 0;
+      f_int   = 0;
+      f_ext   = 0;
+      inertia = 0;
+
+      const unsigned int n   = fe->n_dofs_per_cell();
+      const unsigned int n_q = quadrature->size();
+      FEValues<dim>      fv(mapping, *fe, *quadrature, update_values | update_gradients);
+      FEFaceValues<dim>  ffv(mapping, *fe, *face_quadrature,
+                            update_values | update_quadrature_points | update_JxW_values);
+      const FEValuesExtractors::Vector displacement(0);
+
+      FullMatrix<double>   A(n, n), M(n, n), K0(n, n);
+      dealii::Vector<double> r(n), fi(n), fx(n), fx0(n), fi0(n), du(n), v0(n), a0(n), a1(n), v1(n),
+        Mv(n), Cv0(n), Cv1(n), tmp(n);
+      std::vector<types::global_dof_index>          dofs(n);
+      std::vector<std::vector<SymmetricTensor<2, dim>>> B(n_q, std::vector<SymmetricTensor<2, dim>>(n));
+      std::vector<SymmetricTensor<2, dim>>          CB(n);
+      std::vector<unsigned int>                     comp(n);
+      for (unsigned int i = 0; i < n; ++i)
+        comp[i] = fe->system_to_component_index(i).first;
+
+      // Loads at t1 (and t0 for HHT): body force densities and tractions.
+      const auto &loads = scene.load_descriptions();
+      std::vector<Tensor<1, dim>> load1(load_sets.size()), load0(load_sets.size());
+      for (unsigned int l = 0; l < load_sets.size(); ++l)
+        {
+          load1[l] = loads[load_sets[l].load].value_at(t1) * load_sets[l].scale;
+          if (dynamic)
+            load0[l] = loads[load_sets[l].load].value_at(t0) * load_sets[l].scale;
+        }
+      const Tensor<1, dim> &g = scene.gravity();
+      const unsigned int    n_loads = load_sets.size();
+
+      // f += sum_q N_i (rho g + volume loads) w_q + tractions on the boundary faces
+      // whose centre lies in the load's region (load values already scaled).
+      const auto external = [&](const auto                        &cell,
+                                const CellHistory<dim>            &h,
+                                const std::vector<Tensor<1, dim>> &value,
+                                dealii::Vector<double>            &f) {
+        f                                 = 0;
+        const std::size_t first = cell->active_cell_index() * n_loads;
+        for (unsigned int q = 0; q < n_q; ++q)
+          {
+            Tensor<1, dim> b = h.material->density() * g;
+            for (unsigned int l = 0; l < n_loads; ++l)
+              if (cell_in_load[first + l] && load_sets[l].kind == LoadSet::Kind::volume &&
+                  in_region(l, h.point[q]))
+                b += value[l];
+            for (unsigned int i = 0; i < n; ++i)
+              f[i] += fv.shape_value(i, q) * b[comp[i]] * h.weight[q];
+          }
+        for (unsigned int l = 0; l < n_loads; ++l)
+          if (cell_in_load[first + l] && load_sets[l].kind == LoadSet::Kind::traction)
+            for (const unsigned int face : cell->face_indices())
+              if (cell->face(face)->at_boundary() && in_region(l, cell->face(face)->center()))
+                {
+                  ffv.reinit(cell, face);
+                  for (unsigned int q = 0; q < ffv.n_quadrature_points; ++q)
+                    for (unsigned int i = 0; i < n; ++i)
+                      f[i] += ffv.shape_value(i, q) * value[l][comp[i]] * ffv.JxW(q) * h.thickness;
+                }
+      };
+
+      bool        failed = false;
+      std::string message;
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            fv.reinit(cell);
+            cell->get_dof_indices(dofs);
+            CellHistory<dim> &h   = *history.get_data(cell)[0];
+            const double      rho = h.material->density();
+            for (unsigned int i = 0; i < n; ++i)
+              du[i] = u_iterate(dofs[i]) - u_ghost(dofs[i]);
+            for (unsigned int q = 0; q < n_q; ++q)
+              {
+                for (unsigned int i = 0; i < n; ++i)
+                  B[q][i] = fv[displacement].symmetric_gradient(i, q);
+                SymmetricTensor<2, dim> e;
+                for (unsigned int i = 0; i < n; ++i)
+                  if (du[i] != 0)
+                    e += du[i] * B[q][i];
+                h.increment[q] = e;
+              }
+
+            // The material: from the converged state to the trial state.
+            h.trial_stress = h.stress;
+            h.trial_state  = h.state;
+            if (update_material && !failed)
+              try
+                {
+                  h.material->update(make_array_view(std::as_const(h.increment)),
+                                     make_array_view(h.trial_stress),
+                                     make_array_view(h.trial_state),
+                                     matrix ? make_array_view(h.tangent) :
+                                              ArrayView<SymmetricTensor<4, dim>>());
+                }
+              catch (const RuntimeError &e)
+                {
+                  failed = true;
+                  std::ostringstream m;
+                  m << e.what() << " (in the cell at " << cell->center() << ", body '"
+                    << scene.body_descriptions()[h.body].name << "', step to t = " << t1 << " s)";
+                  message = m.str();
+                }
+            if (failed)
+              continue;
+
+            fi = 0;
+            if (matrix)
+              A = 0;
+            for (unsigned int q = 0; q < n_q; ++q)
+              {
+                const double w = h.weight[q];
+                for (unsigned int i = 0; i < n; ++i)
+                  fi[i] += (B[q][i] * h.trial_stress[q]) * w;
+                if (matrix)
+                  {
+                    for (unsigned int j = 0; j < n; ++j)
+                      CB[j] = h.tangent[q] * B[q][j];
+                    for (unsigned int i = 0; i < n; ++i)
+                      for (unsigned int j = 0; j < n; ++j)
+                        A(i, j) += (B[q][i] * CB[j]) * w;
+                  }
+              }
+            external(cell, h, load1, fx);
+
+            if (dynamic)
+              {
+                // Mass, elastic stiffness (damping) and the Newmark kinematics of the cell.
+                M  = 0;
+                K0 = 0;
+                const SymmetricTensor<4, dim> D = h.material->elasticity().template stiffness<dim>();
+                for (unsigned int q = 0; q < n_q; ++q)
+                  {
+                    const double w = h.weight[q];
+                    for (unsigned int i = 0; i < n; ++i)
+                      for (unsigned int j = 0; j < n; ++j)
+                        if (comp[i] == comp[j])
+                          M(i, j) += rho * fv.shape_value(i, q) * fv.shape_value(j, q) * w;
+                    if (rayleigh_stiffness > 0)
+                      for (unsigned int j = 0; j < n; ++j)
+                        {
+                          const SymmetricTensor<2, dim> DB = D * B[q][j];
+                          for (unsigned int i = 0; i < n; ++i)
+                            K0(i, j) += (B[q][i] * DB) * w;
+                        }
+                  }
+                fi0 = 0;
+                for (unsigned int q = 0; q < n_q; ++q)
+                  for (unsigned int i = 0; i < n; ++i)
+                    fi0[i] += (B[q][i] * h.stress[q]) * h.weight[q];
+                external(cell, h, load0, fx0);
+                for (unsigned int i = 0; i < n; ++i)
+                  {
+                    v0[i] = v_ghost(dofs[i]);
+                    a0[i] = a_ghost(dofs[i]);
+                    a1[i] = (du[i] - dt * v0[i]) / (beta * dt * dt) - (1 - 2 * beta) / (2 * beta) * a0[i];
+                    v1[i] = v0[i] + dt * ((1 - gamma) * a0[i] + gamma * a1[i]);
+                  }
+                // C v = a0 M v + a1 K0 v.
+                M.vmult(Mv, a1);
+                M.vmult(Cv0, v0);
+                M.vmult(Cv1, v1);
+                Cv0 *= rayleigh_mass;
+                Cv1 *= rayleigh_mass;
+                if (rayleigh_stiffness > 0)
+                  {
+                    K0.vmult(tmp, v0);
+                    Cv0.add(rayleigh_stiffness, tmp);
+                    K0.vmult(tmp, v1);
+                    Cv1.add(rayleigh_stiffness, tmp);
+                  }
+                for (unsigned int i = 0; i < n; ++i)
+                  r[i] = Mv[i] + (1 + alpha) * (Cv1[i] + fi[i] - fx[i]) -
+                         alpha * (Cv0[i] + fi0[i] - fx0[i]);
+                if (matrix)
+                  {
+                    const double c_M = 1 / (beta * dt * dt) + (1 + alpha) * gamma / (beta * dt) * rayleigh_mass;
+                    const double c_K0 = (1 + alpha) * gamma / (beta * dt) * rayleigh_stiffness;
+                    for (unsigned int i = 0; i < n; ++i)
+                      for (unsigned int j = 0; j < n; ++j)
+                        A(i, j) = (1 + alpha) * A(i, j) + c_M * M(i, j) + c_K0 * K0(i, j);
+                  }
+                for (unsigned int i = 0; i < n; ++i)
+                  Mv[i] += Cv1[i];
+                inertia.add(dofs, Mv);
+              }
+            else
+              for (unsigned int i = 0; i < n; ++i)
+                r[i] = fi[i] - fx[i];
+
+            if (system)
+              {
+                r *= -1.0;
+                if (matrix)
+                  constraints.distribute_local_to_global(A, r, dofs, system_matrix, system_rhs, true);
+                else
+                  constraints.distribute_local_to_global(r, dofs, system_rhs);
+              }
+            f_int.add(dofs, fi);
+            f_ext.add(dofs, fx);
+          }
+
+      // Forces shared by nodes (a load region without quadrature points).
+      for (unsigned int l = 0; l < n_loads; ++l)
+        if (load_sets[l].kind == LoadSet::Kind::nodal)
+          for (unsigned int k = 0; k < load_sets[l].nodal_dofs.size(); ++k)
+            {
+              const auto         dof = load_sets[l].nodal_dofs[k];
+              const unsigned int c   = load_sets[l].nodal_components[k];
+              f_ext(dof) += load1[l][c];
+              if (system && !constraints.is_constrained(dof))
+                system_rhs(dof) += dynamic ? (1 + alpha) * load1[l][c] - alpha * load0[l][c] : load1[l][c];
+            }
+
+      if (matrix)
+        system_matrix.compress(VectorOperation::add);
+      if (system)
+        system_rhs.compress(VectorOperation::add);
+      f_int.compress(VectorOperation::add);
+      f_ext.compress(VectorOperation::add);
+      inertia.compress(VectorOperation::add);
+
+      // A failure on any rank is a failure everywhere (with the first message).
+      MPI_Comm comm = scene.mpi_communicator();
+      if (dealii::Utilities::MPI::logical_or(failed, comm))
+        {
+          const unsigned int rank  = dealii::Utilities::MPI::this_mpi_process(comm);
+          const unsigned int first = dealii::Utilities::MPI::min(failed ? rank : dealii::numbers::invalid_unsigned_int, comm);
+          material_failure         = dealii::Utilities::MPI::broadcast(comm, message, first);
+          return false;
+        }
+      last_force_level = std::max({f_int.l2_norm(), f_ext.l2_norm(), inertia.l2_norm()});
+      return std::isfinite(last_force_level) && (!system || std::isfinite(system_rhs.l2_norm()));
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::commit(const double t1, const double dt)
+    {
+      (void)t1;
+      using namespace dealii;
+      const Scene<dim> &scene = this->get_scene();
+      MPI_Comm          comm  = scene.mpi_communicator();
+      double            work  = 0;
+      for (const auto &cell : triangulation.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            CellHistory<dim> &h = *history.get_data(cell)[0];
+            for (unsigned int q = 0; q < h.stress.size(); ++q)
+              {
+                // Trapezoidal internal work 1/2 (sigma_n + sigma_n+1) : d eps.
+                work += 0.5 * ((h.stress[q] + h.trial_stress[q]) * h.increment[q]) * h.weight[q];
+                h.strain[q] += h.increment[q];
+              }
+            h.stress.swap(h.trial_stress);
+            h.state.swap(h.trial_state);
+          }
+      internal_work += dealii::Utilities::MPI::sum(work, comm);
+
+      Vector increment = u_trial;
+      increment -= u;
+      if (analysis == Analysis::implicit_dynamics)
+        {
+          const double alpha = hht_alpha, beta = (1 - alpha) * (1 - alpha) / 4, gamma = 0.5 - alpha;
+          // a1 = (du - dt v0) / (beta dt^2) - (1 - 2 beta) / (2 beta) a0; v1 = v0 + dt ((1 - gamma) a0 + gamma a1).
+          Vector a_new = increment;
+          a_new.add(-dt, v);
+          a_new *= 1 / (beta * dt * dt);
+          a_new.add(-(1 - 2 * beta) / (2 * beta), a);
+          v.add(dt * (1 - gamma), a, dt * gamma, a_new);
+          a = a_new;
+          v_ghost = v;
+          a_ghost = a;
+        }
+
+      // External and boundary work (trapezoidal), the reactions of the new state.
+      external_work += 0.5 * (f_ext_old * increment + f_ext * increment);
+      Vector r = f_int;
+      r += inertia;
+      r -= f_ext;
+      double bw = 0;
+      for (unsigned int k = 0; k < constrained_list.size(); ++k)
+        if (owned_dofs.is_element(constrained_list[k]))
+          bw += 0.5 * (reaction_old(constrained_list[k]) + r(constrained_list[k])) *
+                increment(constrained_list[k]);
+      boundary_work += dealii::Utilities::MPI::sum(bw, comm);
+      reaction_old = r;
+      f_int_old    = f_int;
+      f_ext_old    = f_ext;
+      force_scale  = std::max(force_scale, last_force_level);
+      u            = u_trial;
+      u_ghost      = u;
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::elastic_stiffness_product(const Vector &x, Vector &y) const
+    {
+      // y = K0 x = sum_q B_i : D : eps(x) w_q, matrix-free (explicit damping, power iteration).
+      using namespace dealii;
+      const unsigned int n   = fe->n_dofs_per_cell();
+      const unsigned int n_q = quadrature->size();
+      FEValues<dim>      fv(mapping, *fe, *quadrature, update_gradients);
+      const FEValuesExtractors::Vector displacement(0);
+      std::vector<types::global_dof_index> dofs(n);
+      dealii::Vector<double>               xe(n), ye(n);
+      y = 0;
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            fv.reinit(cell);
+            cell->get_dof_indices(dofs);
+            const CellHistory<dim> &h = *history.get_data(cell)[0];
+            const SymmetricTensor<4, dim> D = h.material->elasticity().template stiffness<dim>();
+            for (unsigned int i = 0; i < n; ++i)
+              xe[i] = x(dofs[i]);
+            ye = 0;
+            for (unsigned int q = 0; q < n_q; ++q)
+              {
+                SymmetricTensor<2, dim> e;
+                for (unsigned int i = 0; i < n; ++i)
+                  e += xe[i] * fv[displacement].symmetric_gradient(i, q);
+                const SymmetricTensor<2, dim> s = D * e;
+                for (unsigned int i = 0; i < n; ++i)
+                  ye[i] += (fv[displacement].symmetric_gradient(i, q) * s) * h.weight[q];
+              }
+            y.add(dofs, ye);
+          }
+      y.compress(VectorOperation::add);
+    }
+
+
+
+    template class Solver<2>;
+    template class Solver<3>;
+  } // namespace FEM
+} // namespace hysteron

@@ -1,0 +1,370 @@
+#include <deal.II/base/exceptions.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/vector.h>
+
+#include <hysteron/fem/fem.h>
+
+#include <cmath>
+#include <sstream>
+
+namespace hysteron
+{
+  namespace FEM
+  {
+    template <int dim>
+    double
+    Solver<dim>::prescribed_increment(const unsigned int k, const double t0, const double t1) const
+    {
+      const Scene<dim>  &scene = this->get_scene();
+      const auto        &s     = dirichlet[constrained_set[k]];
+      const unsigned int c     = constrained_component[k];
+      if (s.rigid >= 0)
+        return integrate_in_time<dim>(*scene.body_descriptions()[s.rigid].rigid_velocity, t0, t1)[c];
+      const auto &d = scene.boundary_descriptions()[s.boundary];
+      if (d.velocity || d.displacement)
+        return d.displacement_increment(t0, t1, constrained_point[k])[c];
+      return 0; // fixed, roller
+    }
+
+
+
+    template <int dim>
+    double
+    Solver<dim>::prescribed_velocity(const unsigned int k, const double t, const double dt) const
+    {
+      const Scene<dim>  &scene = this->get_scene();
+      const auto        &s     = dirichlet[constrained_set[k]];
+      const unsigned int c     = constrained_component[k];
+      if (s.rigid >= 0)
+        return evaluate_in_time<dim>(*scene.body_descriptions()[s.rigid].rigid_velocity, t)[c];
+      const auto &d = scene.boundary_descriptions()[s.boundary];
+      if (d.velocity)
+        return evaluate_in_time<dim>(*d.velocity, t)[c];
+      if (d.displacement && dt > 0)
+        return d.step_velocity(t, dt, constrained_point[k])[c];
+      return 0;
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::damping_force(const Vector &velocity, Vector &force, const double factor) const
+    {
+      // force += factor C v, C = a0 M_L + a1 K0 (matrix-free).
+      if (rayleigh_mass > 0)
+        for (const auto i : owned_dofs)
+          force(i) += factor * rayleigh_mass * lumped_mass(i) * velocity(i);
+      if (rayleigh_stiffness > 0)
+        {
+          Vector ghost(owned_dofs, relevant_dofs, this->get_scene().mpi_communicator());
+          ghost = velocity;
+          Vector Kv(owned_dofs, this->get_scene().mpi_communicator());
+          elastic_stiffness_product(ghost, Kv);
+          force.add(factor * rayleigh_stiffness, Kv);
+        }
+      force.compress(dealii::VectorOperation::add);
+    }
+
+
+
+    template <int dim>
+    double
+    Solver<dim>::critical_time_step()
+    {
+      // Central differences are stable for dt <= 2 / omega_max, omega_max^2 the
+      // largest eigenvalue of M_L^-1 K0 on the free DoFs (undamped). Power
+      // iteration on the mass-scaled operator from a start vector that depends
+      // only on the geometry (the same on any number of ranks), with the
+      // Rayleigh quotient as the estimate.
+      MPI_Comm comm = this->get_scene().mpi_communicator();
+      Vector   x(owned_dofs, comm), y(owned_dofs, comm), ghost(owned_dofs, relevant_dofs, comm);
+      std::vector<bool> constrained_owned(owned_dofs.n_elements(), false);
+      for (const auto dof : constrained_list)
+        if (owned_dofs.is_element(dof))
+          constrained_owned[owned_dofs.index_within_set(dof)] = true;
+      // A pseudo-random start vector that is a function of the DoFs' support
+      // points and components (a hash of the coordinates), so that it has
+      // components on every mode and is the same on any number of ranks.
+      for (const auto i : owned_dofs)
+        {
+          const unsigned int k = owned_dofs.index_within_set(i);
+          double             h = 0.37 * owned_component[k];
+          const double       c[3] = {12.9898, 78.233, 37.719};
+          for (unsigned int d = 0; d < dim; ++d)
+            h += c[d] * owned_support[k][d] / u_scale;
+          const double r = std::sin(h) * 43758.5453;
+          x(i)           = constrained_owned[k] ? 0.0 : r - std::floor(r) - 0.5;
+        }
+      x.compress(dealii::VectorOperation::insert);
+
+      double lambda = 0;
+      for (unsigned int it = 0; it < 500; ++it)
+        {
+          // Normalise in the mass norm.
+          double xmx = 0;
+          for (const auto i : owned_dofs)
+            xmx += x(i) * x(i) * lumped_mass(i);
+          xmx = dealii::Utilities::MPI::sum(xmx, comm);
+          x *= 1.0 / std::sqrt(xmx);
+          ghost = x;
+          elastic_stiffness_product(ghost, y);
+          double xkx = 0;
+          for (const auto i : owned_dofs)
+            if (!constrained_owned[owned_dofs.index_within_set(i)])
+              xkx += x(i) * y(i);
+          xkx                 = dealii::Utilities::MPI::sum(xkx, comm);
+          const double change = std::abs(xkx - lambda) / std::max(xkx, 1e-300);
+          lambda              = xkx;
+          for (const auto i : owned_dofs)
+            x(i) = constrained_owned[owned_dofs.index_within_set(i)] ? 0.0 : y(i) / lumped_mass(i);
+          x.compress(dealii::VectorOperation::insert);
+          if (it > 20 && change < 1e-7)
+            break;
+        }
+      return lambda > 0 ? 2.0 / std::sqrt(lambda) : std::numeric_limits<double>::max();
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::setup_dynamics()
+    {
+      using namespace dealii;
+      const Scene<dim> &scene  = this->get_scene();
+      const auto       &bodies = scene.body_descriptions();
+      MPI_Comm          comm   = scene.mpi_communicator();
+      reaction_old.reinit(owned_dofs, comm);
+      v = 0;
+      a = 0;
+      Vector ghost(owned_dofs, relevant_dofs, comm);
+      ghost = u;
+
+      // The forces of the initial state (external work, HHT and the first explicit step).
+      if (analysis != Analysis::explicit_dynamics)
+        make_constraints(0.0, false);
+      assemble(ghost, 0.0, 0.0, Assemble::forces);
+      f_int_old    = f_int;
+      f_ext_old    = f_ext;
+      reaction_old = f_int;
+      reaction_old -= f_ext;
+      if (analysis == Analysis::quasi_static)
+        return;
+
+      // Initial velocities at the DoFs' support points (the body of the cell);
+      // lumped (row-sum) masses.
+      const unsigned int n   = fe->n_dofs_per_cell();
+      const unsigned int n_q = quadrature->size();
+      FEValues<dim>      fv(mapping, *fe, *quadrature, update_values);
+      std::vector<types::global_dof_index> dofs(n);
+      const auto &unit_points = fe->get_unit_support_points();
+      lumped_mass.reinit(owned_dofs, comm);
+      Vector velocity(owned_dofs, comm);
+      dealii::Vector<double> m(n);
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            fv.reinit(cell);
+            cell->get_dof_indices(dofs);
+            const CellHistory<dim> &h   = *history.get_data(cell)[0];
+            const double            rho = h.material->density();
+            m                           = 0;
+            for (unsigned int q = 0; q < n_q; ++q)
+              for (unsigned int i = 0; i < n; ++i)
+                for (unsigned int j = 0; j < n; ++j)
+                  if (fe->system_to_component_index(i).first == fe->system_to_component_index(j).first)
+                    m[i] += rho * fv.shape_value(i, q) * fv.shape_value(j, q) * h.weight[q];
+            lumped_mass.add(dofs, m);
+            for (unsigned int i = 0; i < n; ++i)
+              if (owned_dofs.is_element(dofs[i]))
+                {
+                  const Point<dim> p = mapping.transform_unit_to_real_cell(cell, unit_points[i]);
+                  velocity(dofs[i]) =
+                    bodies[h.body].velocity_at(p)[fe->system_to_component_index(i).first];
+                }
+          }
+      lumped_mass.compress(VectorOperation::add);
+      velocity.compress(VectorOperation::insert);
+      v = velocity;
+      // Prescribed DoFs move with their prescribed velocity.
+      for (unsigned int k = 0; k < constrained_list.size(); ++k)
+        if (owned_dofs.is_element(constrained_list[k]))
+          v(constrained_list[k]) = prescribed_velocity(k, 0.0, 0.0);
+      v.compress(VectorOperation::insert);
+      v_ghost = v;
+
+      // a0 from M a0 = f_ext(0) - f_int(0) - C v0 on the free DoFs (prescribed: 0).
+      if (analysis == Analysis::explicit_dynamics)
+        {
+          critical_step = critical_time_step();
+          Vector force  = f_ext;
+          force -= f_int;
+          damping_force(v, force, -1.0);
+          for (const auto i : owned_dofs)
+            a(i) = force(i) / lumped_mass(i);
+          for (unsigned int k = 0; k < constrained_list.size(); ++k)
+            if (owned_dofs.is_element(constrained_list[k]))
+              a(constrained_list[k]) = 0;
+          a.compress(VectorOperation::insert);
+        }
+      else
+        {
+          assemble_mass_system();
+          Vector x(owned_dofs, comm);
+          solve_linear(x);
+          constraints.distribute(x);
+          a = x;
+        }
+      a_ghost = a;
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::assemble_mass_system()
+    {
+      // The consistent mass matrix (condensed) and the right-hand side
+      // f_ext(0) - f_int(0) - C v0 of the initial acceleration.
+      using namespace dealii;
+      system_matrix = 0;
+      system_rhs    = 0;
+      const unsigned int n   = fe->n_dofs_per_cell();
+      const unsigned int n_q = quadrature->size();
+      FEValues<dim>      fv(mapping, *fe, *quadrature, update_values);
+      FullMatrix<double>     M(n, n);
+      dealii::Vector<double> rhs(n), ve(n);
+      std::vector<types::global_dof_index> dofs(n);
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            fv.reinit(cell);
+            cell->get_dof_indices(dofs);
+            const CellHistory<dim> &h   = *history.get_data(cell)[0];
+            const double            rho = h.material->density();
+            M                           = 0;
+            for (unsigned int q = 0; q < n_q; ++q)
+              for (unsigned int i = 0; i < n; ++i)
+                for (unsigned int j = 0; j < n; ++j)
+                  if (fe->system_to_component_index(i).first == fe->system_to_component_index(j).first)
+                    M(i, j) += rho * fv.shape_value(i, q) * fv.shape_value(j, q) * h.weight[q];
+            for (unsigned int i = 0; i < n; ++i)
+              ve[i] = v_ghost(dofs[i]);
+            M.vmult(rhs, ve);
+            rhs *= -rayleigh_mass;
+            constraints.distribute_local_to_global(M, rhs, dofs, system_matrix, system_rhs);
+          }
+      system_matrix.compress(VectorOperation::add);
+      system_rhs.compress(VectorOperation::add);
+      Vector force = f_ext;
+      force -= f_int;
+      if (rayleigh_stiffness > 0)
+        {
+          Vector Kv(owned_dofs, this->get_scene().mpi_communicator());
+          elastic_stiffness_product(v_ghost, Kv);
+          force.add(-rayleigh_stiffness, Kv);
+        }
+      for (const auto i : owned_dofs)
+        if (!constraints.is_constrained(i))
+          system_rhs(i) += force(i);
+      system_rhs.compress(VectorOperation::insert);
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::explicit_step(const double t, const double dt)
+    {
+      // Velocity Verlet (central differences with velocities at whole steps):
+      //   v_1/2 = v0 + dt/2 a0,  u1 = u0 + dt v_1/2,
+      //   a1 = M_L^-1 (f_ext(t1) - f_int(u1) - C v_1/2),  v1 = v_1/2 + dt/2 a1.
+      // Prescribed DoFs follow their motion exactly; a wall projects the nodes
+      // that would cross it back onto it (the change of momentum is its force).
+      using namespace dealii;
+      const Scene<dim> &scene = this->get_scene();
+      MPI_Comm          comm  = scene.mpi_communicator();
+      const double      t1    = t + dt;
+      Vector            v_half = v;
+      v_half.add(0.5 * dt, a);
+      for (unsigned int k = 0; k < constrained_list.size(); ++k)
+        if (owned_dofs.is_element(constrained_list[k]))
+          v_half(constrained_list[k]) = prescribed_increment(k, t, t1) / dt;
+      v_half.compress(VectorOperation::insert);
+      u_trial = u;
+      u_trial.add(dt, v_half);
+
+      // Walls: x = X + u may not cross the wall plane. The impulse m dv of the
+      // projection is the wall's force times dt; its work m dv (v_before + v_after) / 2
+      // is the kinetic energy the (inelastic) contact removes.
+      std::vector<Tensor<1, dim>> contact(dirichlet.size());
+      double                      wall_work = 0;
+      for (unsigned int k = 0; k < wall_dofs.size(); ++k)
+        {
+          const auto   dof  = wall_dofs[k];
+          const Wall  &w    = walls[wall_of_dof[k]];
+          const double x    = wall_reference[k] + u_trial(dof);
+          if (w.lower ? x < w.position : x > w.position)
+            {
+              const double corrected = w.position - wall_reference[k];
+              const double dv        = (corrected - u_trial(dof)) / dt;
+              u_trial(dof)           = corrected;
+              wall_work += lumped_mass(dof) * dv * (v_half(dof) + 0.5 * dv);
+              v_half(dof) += dv;
+              contact[w.set][w.direction] += lumped_mass(dof) * dv / dt;
+            }
+        }
+      u_trial.compress(VectorOperation::insert);
+      v_half.compress(VectorOperation::insert);
+
+      Vector ghost(owned_dofs, relevant_dofs, comm);
+      ghost = u_trial;
+      if (!assemble(ghost, t1, dt, Assemble::forces))
+        fail("fem: " + (material_failure.empty() ? std::string("non-finite forces") : material_failure) +
+               " in the explicit step to t = " + std::to_string(t1) + " s.",
+             t);
+      Vector force = f_ext;
+      force -= f_int;
+      Vector damping(owned_dofs, comm);
+      damping_force(v_half, damping, 1.0);
+      force -= damping;
+      Vector a_new(owned_dofs, comm);
+      for (const auto i : owned_dofs)
+        a_new(i) = force(i) / lumped_mass(i);
+      // Prescribed DoFs: the acceleration that ends the step at the prescribed velocity.
+      for (unsigned int k = 0; k < constrained_list.size(); ++k)
+        if (owned_dofs.is_element(constrained_list[k]))
+          {
+            const auto dof = constrained_list[k];
+            a_new(dof) = 2 * (prescribed_velocity(k, t1, dt) - v_half(dof)) / dt;
+          }
+      a_new.compress(VectorOperation::insert);
+      v = v_half;
+      v.add(0.5 * dt, a_new);
+      a = a_new;
+      // The inertia and damping forces (reactions = M a + C v + f_int - f_ext on prescribed DoFs).
+      for (const auto i : owned_dofs)
+        inertia(i) = lumped_mass(i) * a_new(i) + damping(i);
+      inertia.compress(VectorOperation::insert);
+      for (unsigned int s = 0; s < dirichlet.size(); ++s)
+        contact[s] = Utilities::MPI::sum(contact[s], comm);
+      wall_forces = contact;
+      boundary_work += Utilities::MPI::sum(wall_work, comm);
+
+      const double check = u_trial.linfty_norm() + v.linfty_norm();
+      if (!std::isfinite(check))
+        fail("fem: a non-finite displacement or velocity in the explicit step to t = " +
+               std::to_string(t1) + " s (time step " + std::to_string(dt) + " s, critical " +
+               std::to_string(critical_step) + " s).",
+             t);
+      commit(t1, dt);
+      v_ghost = v;
+      a_ghost = a;
+    }
+
+    template class Solver<2>;
+    template class Solver<3>;
+  } // namespace FEM
+} // namespace hysteron

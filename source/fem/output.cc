@@ -1,0 +1,421 @@
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/numerics/data_out.h>
+
+#include <hysteron/fem/fem.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace hysteron
+{
+  namespace FEM
+  {
+    template <int dim>
+    void
+    Solver<dim>::setup_probes()
+    {
+      using namespace dealii;
+      const Scene<dim>  &scene = this->get_scene();
+      MPI_Comm           comm  = scene.mpi_communicator();
+      const unsigned int rank  = Utilities::MPI::this_mpi_process(comm);
+      probes.clear();
+      for (const auto &p : scene.output_control().probe_points)
+        {
+          Probe probe;
+          probe.point = p;
+          // The locally owned cell that contains the point (lowest rank wins).
+          bool found = false;
+          try
+            {
+              const auto cell_and_point = GridTools::find_active_cell_around_point(mapping, dof_handler, p);
+              if (cell_and_point.first.state() == IteratorState::valid &&
+                  cell_and_point.first->is_locally_owned())
+                {
+                  probe.dof_cell  = cell_and_point.first;
+                  probe.reference = GeometryInfo<dim>::project_to_unit_cell(cell_and_point.second);
+                  found           = true;
+                }
+            }
+          catch (...)
+            {}
+          probe.owner = Utilities::MPI::min(found ? rank : numbers::invalid_unsigned_int, comm);
+          if (probe.owner == static_cast<int>(numbers::invalid_unsigned_int))
+            {
+              std::ostringstream s;
+              s << p;
+              throw InputError("Output/Probe points",
+                               "the point (" + s.str() + ") lies outside the fem mesh");
+            }
+          if (probe.owner != static_cast<int>(rank))
+            found = false;
+          probe.has_cell = found;
+
+          // The nearest quadrature point (ties: the lowest rank, then the first found).
+          double best = std::numeric_limits<double>::max();
+          for (const auto &cell : triangulation.active_cell_iterators())
+            if (cell->is_locally_owned())
+              {
+                const CellHistory<dim> &h = *history.get_data(cell)[0];
+                for (unsigned int q = 0; q < h.point.size(); ++q)
+                  if (h.point[q].distance(p) < best)
+                    {
+                      best          = h.point[q].distance(p);
+                      probe.cell    = cell;
+                      probe.q       = q;
+                      probe.q_point = h.point[q];
+                    }
+              }
+          const double global_best = Utilities::MPI::min(best, comm);
+          const unsigned int q_owner =
+            Utilities::MPI::min(best == global_best ? rank : numbers::invalid_unsigned_int, comm);
+          probe.has_q = q_owner == rank;
+          probes.push_back(probe);
+        }
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::open_tables()
+    {
+      const Scene<dim> &scene = this->get_scene();
+      if (!scene.is_root())
+        return;
+      const auto point = PointData::columns<dim>(state_names);
+      for (unsigned int i = 0; i < probes.size(); ++i)
+        {
+          std::vector<std::string> columns{"time"};
+          columns.insert(columns.end(), point.begin(), point.end());
+          probe_tables.push_back(std::make_unique<Output::CsvWriter>(
+            this->output_file("probe_" + std::to_string(i) + ".csv"), columns));
+        }
+      for (unsigned int i = 0; i < scene.output_control().average_regions.size(); ++i)
+        {
+          std::vector<std::string> columns{"time", "mass"};
+          columns.insert(columns.end(), point.begin(), point.end());
+          average_tables.push_back(std::make_unique<Output::CsvWriter>(
+            this->output_file("average_" + std::to_string(i) + ".csv"), columns));
+        }
+      energy_table = std::make_unique<Output::CsvWriter>(this->output_file("energy.csv"),
+                                                         PointData::energy_columns());
+      reaction_table = std::make_unique<Output::CsvWriter>(this->output_file("reactions.csv"),
+                                                           PointData::reaction_columns(scene));
+      if (analysis != Analysis::explicit_dynamics)
+        newton_table = std::make_unique<Output::CsvWriter>(
+          this->output_file("newton.csv"),
+          std::vector<std::string>{"time", "step", "iteration", "residual", "force_level",
+                                   "relative_residual", "line_search"});
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::log_newton(const double       t1,
+                            const double       dt,
+                            const unsigned int iteration,
+                            const double       residual,
+                            const double       alpha)
+    {
+      if (newton_table)
+        {
+          const double level = force_level();
+          newton_table->add_row(
+            {t1, dt, double(iteration), residual, level, level > 0 ? residual / level : 0.0, alpha});
+        }
+    }
+
+
+
+    template <int dim>
+    std::vector<dealii::Tensor<1, dim>>
+    Solver<dim>::reactions() const
+    {
+      // The force of each constraint on the body: f_int + M a + C v - f_ext at its DoFs.
+      MPI_Comm                            comm = this->get_scene().mpi_communicator();
+      std::vector<dealii::Tensor<1, dim>> r(dirichlet.size());
+      for (unsigned int k = 0; k < constrained_list.size(); ++k)
+        {
+          const auto dof = constrained_list[k];
+          if (owned_dofs.is_element(dof))
+            r[constrained_set[k]][constrained_component[k]] += f_int(dof) + inertia(dof) - f_ext(dof);
+        }
+      for (unsigned int s = 0; s < dirichlet.size(); ++s)
+        {
+          r[s] = dealii::Utilities::MPI::sum(r[s], comm);
+          if (s < wall_forces.size())
+            r[s] += wall_forces[s];
+        }
+      return r;
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::write_table_rows(const double t)
+    {
+      using namespace dealii;
+      const Scene<dim>  &scene     = this->get_scene();
+      MPI_Comm           comm      = scene.mpi_communicator();
+      const unsigned int n_values  = PointData::columns<dim>(state_names).size();
+      const unsigned int n_columns = 1 + n_values;
+      const auto        &regions   = scene.output_control().average_regions;
+      const FEValuesExtractors::Vector displacement(0);
+
+      // Probes: the owner of the cell gives position, displacement and velocity at
+      // the point; the owner of the nearest quadrature point its stress and state.
+      std::vector<double> rows(probes.size() * n_columns, 0.0);
+      for (unsigned int i = 0; i < probes.size(); ++i)
+        {
+          double *row = rows.data() + i * n_columns + 1;
+          if (probes[i].has_q)
+            {
+              const CellHistory<dim> &h = *history.get_data(probes[i].cell)[0];
+              const unsigned int      q = probes[i].q;
+              PointData::values<dim>(Point<dim>(),
+                                     Tensor<1, dim>(),
+                                     Tensor<1, dim>(),
+                                     h.stress[q],
+                                     h.strain[q],
+                                     h.material,
+                                     make_array_view(h.state.data() + q * h.n_state,
+                                                     h.state.data() + (q + 1) * h.n_state),
+                                     state_names.size(),
+                                     row);
+            }
+          if (probes[i].has_cell)
+            {
+              const Quadrature<dim> at(probes[i].reference);
+              FEValues<dim>         fv(mapping, *fe, at, update_values);
+              fv.reinit(probes[i].dof_cell);
+              std::vector<Tensor<1, dim>> uu(1), vv(1);
+              fv[displacement].get_function_values(u_ghost, uu);
+              if (analysis != Analysis::quasi_static)
+                fv[displacement].get_function_values(v_ghost, vv);
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  row[d]           = probes[i].point[d] + uu[0][d];
+                  row[dim + d]     = uu[0][d];
+                  row[2 * dim + d] = vv[0][d];
+                }
+            }
+        }
+
+      // Averages, kinetic and strain energy over the quadrature points.
+      std::vector<double> averages(regions.size() * (1 + n_values), 0.0), values(n_values);
+      double              kinetic = 0, strain_energy = 0;
+      const unsigned int  n_q = quadrature->size();
+      FEValues<dim>       fv(mapping, *fe, *quadrature, update_values);
+      std::vector<Tensor<1, dim>> uq(n_q), vq(n_q);
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            const CellHistory<dim> &h = *history.get_data(cell)[0];
+            fv.reinit(cell);
+            fv[displacement].get_function_values(u_ghost, uq);
+            if (analysis != Analysis::quasi_static)
+              fv[displacement].get_function_values(v_ghost, vq);
+            const double rho = h.material->density();
+            for (unsigned int q = 0; q < n_q; ++q)
+              {
+                const ArrayView<const double> state(h.state.data() + q * h.n_state, h.n_state);
+                strain_energy +=
+                  h.weight[q] * PointData::strain_energy_density(*h.material, h.stress[q], h.strain[q], state);
+                if (analysis == Analysis::implicit_dynamics)
+                  kinetic += 0.5 * rho * vq[q].norm_square() * h.weight[q];
+                for (unsigned int r = 0; r < regions.size(); ++r)
+                  if (regions[r].contains(h.point[q], 1e-9 * u_scale))
+                    {
+                      double      *avg  = averages.data() + r * (1 + n_values);
+                      const double mass = rho * h.weight[q];
+                      PointData::values<dim>(h.point[q] + uq[q], uq[q], vq[q], h.stress[q], h.strain[q],
+                                             h.material, state, state_names.size(), values.data());
+                      avg[0] += mass;
+                      for (unsigned int c = 0; c < n_values; ++c)
+                        avg[1 + c] += mass * values[c];
+                    }
+              }
+          }
+      if (analysis == Analysis::explicit_dynamics)
+        for (const auto i : owned_dofs)
+          kinetic += 0.5 * lumped_mass(i) * v(i) * v(i);
+
+      std::vector<double> sums{kinetic, strain_energy};
+      for (auto *w : {&rows, &sums, &averages})
+        if (!w->empty())
+          Utilities::MPI::sum(*w, comm, *w);
+      const auto r = reactions();
+      if (!scene.is_root())
+        return;
+      for (unsigned int i = 0; i < probes.size(); ++i)
+        {
+          std::vector<double> row(rows.begin() + i * n_columns, rows.begin() + (i + 1) * n_columns);
+          row[0] = t;
+          probe_tables[i]->add_row(row);
+        }
+      for (unsigned int i = 0; i < regions.size(); ++i)
+        {
+          const double       *avg = averages.data() + i * (1 + n_values);
+          std::vector<double> row{t, avg[0]};
+          for (unsigned int c = 0; c < n_values; ++c)
+            row.push_back(avg[0] > 0 ? avg[1 + c] / avg[0] : 0.0);
+          average_tables[i]->add_row(row);
+        }
+      energy_table->add_row(energy_log.row(t, sums[0], sums[1], internal_work, external_work, boundary_work));
+      std::vector<double> row{t};
+      for (const auto &force : r)
+        for (unsigned int d = 0; d < dim; ++d)
+          row.push_back(force[d]);
+      reaction_table->add_row(row);
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::write_fields(const double t)
+    {
+      using namespace dealii;
+      const Scene<dim> &scene = this->get_scene();
+      if (!scene.output_control().write_vtu)
+        return;
+      // Cell averages of the quadrature-point values.
+      const unsigned int n_cells = triangulation.n_active_cells();
+      const unsigned int n_sym   = SymmetricTensor<2, dim>::n_independent_components;
+      std::vector<dealii::Vector<float>> stress(n_sym, dealii::Vector<float>(n_cells)),
+        strain(n_sym, dealii::Vector<float>(n_cells)),
+        state(state_names.size(), dealii::Vector<float>(n_cells));
+      dealii::Vector<float> von_mises(n_cells), body(n_cells), subdomain(n_cells);
+      std::vector<double>   values(PointData::columns<dim>(state_names).size());
+      for (const auto &cell : triangulation.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            const CellHistory<dim> &h = *history.get_data(cell)[0];
+            const unsigned int      c = cell->active_cell_index();
+            double                  volume = 0;
+            for (unsigned int q = 0; q < h.weight.size(); ++q)
+              volume += h.weight[q];
+            for (unsigned int q = 0; q < h.weight.size(); ++q)
+              {
+                const double w = h.weight[q] / volume;
+                PointData::values<dim>(h.point[q], Tensor<1, dim>(), Tensor<1, dim>(), h.stress[q],
+                                       h.strain[q], h.material,
+                                       make_array_view(h.state.data() + q * h.n_state,
+                                                       h.state.data() + (q + 1) * h.n_state),
+                                       state_names.size(), values.data());
+                // values: x, u, v (dim each), stress (n_sym), von Mises, strain, state
+                for (unsigned int k = 0; k < n_sym; ++k)
+                  {
+                    stress[k][c] += w * values[3 * dim + k];
+                    strain[k][c] += w * values[3 * dim + n_sym + 1 + k];
+                  }
+                von_mises[c] += w * values[3 * dim + n_sym];
+                for (unsigned int k = 0; k < state_names.size(); ++k)
+                  state[k][c] += w * values[3 * dim + 2 * n_sym + 1 + k];
+              }
+            body[c]      = h.body;
+            subdomain[c] = triangulation.locally_owned_subdomain();
+          }
+      DataOut<dim> data_out;
+      data_out.attach_dof_handler(dof_handler);
+      const std::vector<DataComponentInterpretation::DataComponentInterpretation> vector(
+        dim, DataComponentInterpretation::component_is_part_of_vector);
+      data_out.add_data_vector(u_ghost, std::vector<std::string>(dim, "displacement"),
+                               DataOut<dim>::type_dof_data, vector);
+      if (analysis != Analysis::quasi_static)
+        data_out.add_data_vector(v_ghost, std::vector<std::string>(dim, "velocity"),
+                                 DataOut<dim>::type_dof_data, vector);
+      const auto columns = PointData::columns<dim>(state_names);
+      for (unsigned int k = 0; k < n_sym; ++k)
+        {
+          data_out.add_data_vector(stress[k], columns[3 * dim + k], DataOut<dim>::type_cell_data);
+          data_out.add_data_vector(strain[k], columns[3 * dim + n_sym + 1 + k], DataOut<dim>::type_cell_data);
+        }
+      data_out.add_data_vector(von_mises, "von_mises", DataOut<dim>::type_cell_data);
+      for (unsigned int k = 0; k < state_names.size(); ++k)
+        data_out.add_data_vector(state[k], state_names[k], DataOut<dim>::type_cell_data);
+      data_out.add_data_vector(body, "body", DataOut<dim>::type_cell_data);
+      data_out.add_data_vector(subdomain, "subdomain", DataOut<dim>::type_cell_data);
+      data_out.build_patches(mapping, degree);
+      field_writer->write(data_out, t);
+      ++n_outputs;
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::write_quadrature_table() const
+    {
+      using namespace dealii;
+      const Scene<dim>  &scene   = this->get_scene();
+      const auto         columns = PointData::columns<dim>(state_names);
+      const unsigned int width   = columns.size() + 1 + dim;
+      const unsigned int n_q     = quadrature->size();
+      const FEValuesExtractors::Vector displacement(0);
+      FEValues<dim>               fv(mapping, *fe, *quadrature, update_values);
+      std::vector<Tensor<1, dim>> uq(n_q), vq(n_q);
+      std::vector<double>         rows;
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            const CellHistory<dim> &h = *history.get_data(cell)[0];
+            fv.reinit(cell);
+            fv[displacement].get_function_values(u_ghost, uq);
+            if (analysis != Analysis::quasi_static)
+              fv[displacement].get_function_values(v_ghost, vq);
+            for (unsigned int q = 0; q < n_q; ++q)
+              {
+                // Sort key (reference position), then body and the point columns.
+                for (unsigned int d = 0; d < dim; ++d)
+                  rows.push_back(h.point[q][d]);
+                rows.push_back(h.body);
+                const std::size_t start = rows.size();
+                rows.resize(start + columns.size());
+                PointData::values<dim>(h.point[q] + uq[q], uq[q], vq[q], h.stress[q], h.strain[q],
+                                       h.material,
+                                       make_array_view(h.state.data() + q * h.n_state,
+                                                       h.state.data() + (q + 1) * h.n_state),
+                                       state_names.size(), rows.data() + start);
+              }
+          }
+      const auto all = Utilities::MPI::gather(scene.mpi_communicator(), rows, 0);
+      if (!scene.is_root())
+        return;
+      std::vector<std::vector<double>> table;
+      for (const auto &part : all)
+        for (std::size_t i = 0; i < part.size(); i += width)
+          table.emplace_back(part.begin() + i, part.begin() + i + width);
+      std::sort(table.begin(), table.end());
+      std::vector<std::string> header{"body"};
+      header.insert(header.end(), columns.begin(), columns.end());
+      Output::CsvWriter out(this->output_file("quadrature_points.csv"), header);
+      for (const auto &row : table)
+        out.add_row(std::vector<double>(row.begin() + dim, row.end()));
+      out.commit();
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::commit_tables()
+    {
+      for (auto &table : probe_tables)
+        table->commit();
+      for (auto &table : average_tables)
+        table->commit();
+      for (auto *table : {energy_table.get(), reaction_table.get(), newton_table.get()})
+        if (table)
+          table->commit();
+    }
+
+    template class Solver<2>;
+    template class Solver<3>;
+  } // namespace FEM
+} // namespace hysteron
