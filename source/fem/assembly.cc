@@ -125,7 +125,7 @@ namespace hysteron
           {
             fv.reinit(cell);
             cell->get_dof_indices(dofs);
-            CellHistory<dim> &h   = *history.get_data(cell)[0];
+            CellHistory<dim> &h   = *cell_history[cell->active_cell_index()];
             const double      rho = h.material->density();
             for (unsigned int i = 0; i < n; ++i)
               du[i] = u_iterate(dofs[i]) - u_ghost(dofs[i]);
@@ -306,7 +306,7 @@ namespace hysteron
       for (const auto &cell : triangulation.active_cell_iterators())
         if (cell->is_locally_owned())
           {
-            CellHistory<dim> &h = *history.get_data(cell)[0];
+            CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
             for (unsigned int q = 0; q < h.stress.size(); ++q)
               {
                 // Trapezoidal internal work 1/2 (sigma_n + sigma_n+1) : d eps.
@@ -373,7 +373,7 @@ namespace hysteron
           {
             fv.reinit(cell);
             cell->get_dof_indices(dofs);
-            const CellHistory<dim> &h = *history.get_data(cell)[0];
+            const CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
             const SymmetricTensor<4, dim> D = h.material->elasticity().template stiffness<dim>();
             for (unsigned int i = 0; i < n; ++i)
               xe[i] = x(dofs[i]);

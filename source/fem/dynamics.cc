@@ -168,7 +168,7 @@ namespace hysteron
           {
             fv.reinit(cell);
             cell->get_dof_indices(dofs);
-            const CellHistory<dim> &h   = *history.get_data(cell)[0];
+            const CellHistory<dim> &h   = *cell_history[cell->active_cell_index()];
             const double            rho = h.material->density();
             m                           = 0;
             for (unsigned int q = 0; q < n_q; ++q)
@@ -242,7 +242,7 @@ namespace hysteron
           {
             fv.reinit(cell);
             cell->get_dof_indices(dofs);
-            const CellHistory<dim> &h   = *history.get_data(cell)[0];
+            const CellHistory<dim> &h   = *cell_history[cell->active_cell_index()];
             const double            rho = h.material->density();
             M                           = 0;
             for (unsigned int q = 0; q < n_q; ++q)

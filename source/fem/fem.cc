@@ -511,10 +511,14 @@ namespace hysteron
       dealii::FEValues<dim> fv(mapping, *fe, *quadrature,
                                dealii::update_quadrature_points | dealii::update_JxW_values);
       history.initialize(triangulation.begin_active(), triangulation.end(), 1);
+      // Raw pointers by active cell index: get_data() returns a vector of shared
+      // pointers (an allocation per call), too slow for the assembly loops.
+      cell_history.assign(triangulation.n_active_cells(), nullptr);
       for (const auto &cell : triangulation.active_cell_iterators())
         if (cell->is_locally_owned())
           {
-            auto &h     = *history.get_data(cell)[0];
+            cell_history[cell->active_cell_index()] = history.get_data(cell)[0].get();
+            auto &h     = *cell_history[cell->active_cell_index()];
             const unsigned int m = cell->material_id();
             h.material  = body_material[m];
             h.body      = mesh_to_body[m];
@@ -729,7 +733,7 @@ namespace hysteron
       for (const auto &cell : triangulation.active_cell_iterators())
         if (cell->is_locally_owned())
           {
-            const CellHistory<dim> &h     = *history.get_data(cell)[0];
+            const CellHistory<dim> &h     = *cell_history[cell->active_cell_index()];
             const std::size_t       first = cell->active_cell_index() * n_loads;
             for (unsigned int l = 0; l < n_loads; ++l)
               if (load_sets[l].kind == LoadSet::Kind::volume)
@@ -1023,6 +1027,9 @@ namespace hysteron
                 }
             }
           t += dt;
+          // Times on the nominal grid stay exact (no drift of the sum of steps).
+          if (const double k = std::round(t / nominal); std::abs(t - k * nominal) < 1e-9 * nominal)
+            t = k * nominal;
           ++n_steps;
           const bool last = !(t < time.end_time - eps);
           if (probe_interval == 0 || t >= next_row - eps || last)

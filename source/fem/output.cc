@@ -58,7 +58,7 @@ namespace hysteron
           for (const auto &cell : triangulation.active_cell_iterators())
             if (cell->is_locally_owned())
               {
-                const CellHistory<dim> &h = *history.get_data(cell)[0];
+                const CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
                 for (unsigned int q = 0; q < h.point.size(); ++q)
                   if (h.point[q].distance(p) < best)
                     {
@@ -175,7 +175,7 @@ namespace hysteron
           double *row = rows.data() + i * n_columns + 1;
           if (probes[i].has_q)
             {
-              const CellHistory<dim> &h = *history.get_data(probes[i].cell)[0];
+              const CellHistory<dim> &h = *cell_history[probes[i].cell->active_cell_index()];
               const unsigned int      q = probes[i].q;
               PointData::values<dim>(Point<dim>(),
                                      Tensor<1, dim>(),
@@ -215,7 +215,7 @@ namespace hysteron
       for (const auto &cell : dof_handler.active_cell_iterators())
         if (cell->is_locally_owned())
           {
-            const CellHistory<dim> &h = *history.get_data(cell)[0];
+            const CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
             fv.reinit(cell);
             fv[displacement].get_function_values(u_ghost, uq);
             if (analysis != Analysis::quasi_static)
@@ -295,7 +295,7 @@ namespace hysteron
       for (const auto &cell : triangulation.active_cell_iterators())
         if (cell->is_locally_owned())
           {
-            const CellHistory<dim> &h = *history.get_data(cell)[0];
+            const CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
             const unsigned int      c = cell->active_cell_index();
             double                  volume = 0;
             for (unsigned int q = 0; q < h.weight.size(); ++q)
@@ -364,7 +364,7 @@ namespace hysteron
       for (const auto &cell : dof_handler.active_cell_iterators())
         if (cell->is_locally_owned())
           {
-            const CellHistory<dim> &h = *history.get_data(cell)[0];
+            const CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
             fv.reinit(cell);
             fv[displacement].get_function_values(u_ghost, uq);
             if (analysis != Analysis::quasi_static)

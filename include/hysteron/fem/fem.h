@@ -300,6 +300,7 @@ namespace hysteron
       Vector                                            system_rhs;
       dealii::CellDataStorage<typename dealii::Triangulation<dim>::cell_iterator, CellHistory<dim>>
         history;
+      std::vector<CellHistory<dim> *>               cell_history; ///< by active cell index (owned cells)
       std::vector<const Material::Interface<dim> *> body_material;
       std::vector<unsigned int>                     body_to_mesh; ///< scene body -> material id
       std::vector<unsigned int>                     mesh_to_body;
