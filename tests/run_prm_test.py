@@ -15,10 +15,15 @@ The scene runs in a fresh working directory (relative output paths land there) w
   # EXPECT-STDERR: <regex>        stderr must match (e.g. a warning) on a successful run
   # EXPECT-STDOUT: <regex>        stdout must match on a successful run
   # ARGS: <arguments>             command line instead of "--quiet <prm>" ({prm} = the file)
+  # FILES: <path>[, <path>]       input files the scene reads (paths relative to the .prm),
+                                  copied into the working directory with the .prm
   # MPI: 2                        also run on 2 ranks; every output file must be identical
   # MPI-TOLERANCE: 1e-10[, 1e-14] with MPI: CSV values may differ by this fraction of the
                                   largest magnitude in their column (sums in another order),
                                   or by the optional absolute amount (columns of round-off)
+  # MPI-IGNORE: newton.csv        with MPI: files that must exist on 2 ranks but whose values
+                                  are not compared (solver diagnostics such as residual norms
+                                  at round-off level)
 
 Expressions are Python over the CSV column names, with abs, sqrt, exp, log, tanh, sin, cos,
 pi, min, max, sum, len, all, any, and `i` (the row index) for CHECK.
@@ -44,7 +49,7 @@ SAFE = {
 def parse_directives(path):
     directives = []
     pattern = re.compile(r"^\s*#\s*(CHECK-LAST|CHECK-COLUMNS|CHECK|EXPECT-ERROR|EXPECT-STDERR|EXPECT-STDOUT|EXIT|"
-                         r"ARGS|MPI-TOLERANCE|MPI)\b\s*([^:]*):\s?(.*)$")
+                         r"ARGS|FILES|MPI-TOLERANCE|MPI-IGNORE|MPI)\b\s*([^:]*):\s?(.*)$")
     with open(path) as f:
         for line in f:
             m = pattern.match(line)
@@ -112,6 +117,15 @@ def main():
     os.makedirs(args.workdir)
     local_prm = os.path.join(args.workdir, os.path.basename(prm))
     shutil.copy(prm, local_prm)
+    inputs = [x.strip() for k, _, v in directives if k == "FILES" for x in v.split(",") if x.strip()]
+
+    def copy_inputs(directory):
+        for name in inputs:
+            target = os.path.join(directory, name)
+            os.makedirs(os.path.dirname(target) or directory, exist_ok=True)
+            shutil.copy(os.path.join(os.path.dirname(prm), name), target)
+
+    copy_inputs(args.workdir)
 
     arg_line = next((v for k, _, v in directives if k == "ARGS"), "--quiet {prm}")
     command = [args.hysteron] + [a.replace("{prm}", os.path.basename(prm))
@@ -138,7 +152,7 @@ def main():
         # Bad input (exit 1) writes nothing; a run that fails (exit 2) keeps its last good
         # state, complete files only.
         left = [f for f in output_files(args.workdir)
-                if f != os.path.basename(prm) and not f.endswith("parameters.prm")
+                if f != os.path.basename(prm) and not f.endswith("parameters.prm") and f not in inputs
                 and (expected_code == 1 or f.endswith(".tmp"))]
         if left:
             failures.append(f"output files left behind after a failed run: {left}")
@@ -197,6 +211,7 @@ def main():
             shutil.rmtree(mpi_dir, ignore_errors=True)
             os.makedirs(mpi_dir)
             shutil.copy(prm, mpi_dir)
+            copy_inputs(mpi_dir)
             mpi_command = [args.mpiexec, "-np", str(ranks)] + command
             code2, out2, err2 = run(mpi_command, mpi_dir, env)
             print("$ " + " ".join(mpi_command))
@@ -205,9 +220,12 @@ def main():
                 continue
             one, two = output_files(args.workdir), output_files(mpi_dir)
             comparable = [f for f in one if f.endswith(".csv")]
+            ignored = [x.strip() for k, _, v in directives if k == "MPI-IGNORE" for x in v.split(",")]
             for f in comparable:
                 if f not in two:
                     failures.append(f"{ranks} ranks: {f} missing")
+                elif os.path.basename(f) in ignored:
+                    continue
                 elif tolerance is not None:
                     problem = compare_csv(os.path.join(args.workdir, f), os.path.join(mpi_dir, f),
                                           tolerance)

@@ -297,8 +297,10 @@ namespace hysteron
       u_trial.add(dt, v_half);
 
       // Walls: x = X + u may not cross the wall plane. The impulse m dv of the
-      // projection is the wall's force times dt; its work m dv (v_before + v_after) / 2
-      // is the kinetic energy the (inelastic) contact removes.
+      // projection is the wall's force times dt; a fixed wall does the work F . du with
+      // the node's displacement of the step (zero for a node that stays on it). The
+      // kinetic energy the projection removes (a perfectly inelastic contact of the node)
+      // is a loss that shows in the energy balance.
       std::vector<Tensor<1, dim>> contact(dirichlet.size());
       double                      wall_work = 0;
       for (unsigned int k = 0; k < wall_dofs.size(); ++k)
@@ -311,7 +313,7 @@ namespace hysteron
               const double corrected = w.position - wall_reference[k];
               const double dv        = (corrected - u_trial(dof)) / dt;
               u_trial(dof)           = corrected;
-              wall_work += lumped_mass(dof) * dv * (v_half(dof) + 0.5 * dv);
+              wall_work += lumped_mass(dof) * dv / dt * (corrected - u(dof));
               v_half(dof) += dv;
               contact[w.set][w.direction] += lumped_mass(dof) * dv / dt;
             }

@@ -127,7 +127,8 @@ namespace hysteron
                             "",
                             Patterns::Anything(),
                             "Generator = file: a Gmsh .msh file (ASCII or binary, version 2 or "
-                            "4) with quadrilaterals (2D) or hexahedra (3D).");
+                            "4) with quadrilaterals (2D) or hexahedra (3D); a relative name is "
+                            "looked up in the working directory, then beside the parameter file.");
         }
         prm.leave_subsection();
 
@@ -227,14 +228,15 @@ namespace hysteron
         generator   = s.get("Generator");
         cell_size   = s.get_non_negative("Cell size");
         refinements = s.get_integer("Refinements");
-        mesh_file   = dealii::Utilities::trim(s.get("Mesh file"));
+        mesh_file   = scene.resolve_input_file(dealii::Utilities::trim(s.get("Mesh file")));
         if (generator == "file")
           {
             require(!mesh_file.empty(), s.where("Mesh file"), "Generator = file needs a mesh file");
             std::error_code ec;
             require(std::filesystem::is_regular_file(mesh_file, ec),
                     s.where("Mesh file"),
-                    "cannot open '" + mesh_file + "': no such file");
+                    "cannot open '" + mesh_file + "': no such file (relative names are looked up "
+                    "in the working directory, then beside the parameter file)");
           }
         else
           {
@@ -851,6 +853,7 @@ namespace hysteron
       MPI_Comm          comm  = scene.mpi_communicator();
       const double      t1    = t + dt;
       current_dt              = dt;
+      material_failure.clear();
       Vector du(owned_dofs, comm), ghost(owned_dofs, relevant_dofs, comm);
 
       // Predictor: the tangent of the converged state, the prescribed increments
@@ -874,7 +877,7 @@ namespace hysteron
         {
           if (!std::isfinite(residual))
             return false;
-          if (residual <= newton_tolerance * force_level())
+          if (residual <= residual_target())
             {
               n_newton += iteration;
               return true;
@@ -885,14 +888,16 @@ namespace hysteron
           Vector start = u_trial;
           double alpha = 1.0, trial = 0;
           bool   ok    = true;
-          for (unsigned int k = 0; k <= (line_search ? 6u : 0u); ++k)
+          // Below 1e-10 of the force level the residual is round-off: full steps only.
+          const bool noise = residual <= 1e-10 * force_level();
+          for (unsigned int k = 0; k <= (line_search && !noise ? 6u : 0u); ++k)
             {
               u_trial = start;
               u_trial.add(alpha, du);
               ghost = u_trial;
               ok    = assemble(ghost, t1, dt, k == 0 ? Assemble::residual_and_matrix : Assemble::forces);
               trial = ok ? system_rhs.l2_norm() : std::numeric_limits<double>::infinity();
-              if ((ok && trial <= (1 - 1e-4 * alpha) * residual) || !line_search)
+              if ((ok && trial <= (1 - 1e-4 * alpha) * residual) || !line_search || noise)
                 break;
               alpha *= 0.5;
             }
@@ -908,11 +913,18 @@ namespace hysteron
                 return false;
               trial = system_rhs.l2_norm();
             }
-          residual = trial;
+          // Converged to round-off: no progress any more below 1e-10 of the force level.
+          const bool stagnated = trial > 0.5 * residual && trial <= 1e-10 * force_level();
+          residual             = trial;
           log_newton(t1, dt, iteration, residual, alpha);
+          if (stagnated && std::isfinite(residual))
+            {
+              n_newton += iteration;
+              return true;
+            }
         }
       n_newton += newton_max_iterations;
-      return residual <= newton_tolerance * force_level();
+      return residual <= residual_target();
     }
 
 
@@ -1010,11 +1022,12 @@ namespace hysteron
                         << " s to " << t + dt << " s after " << max_cuts
                         << " cuts (increment " << dt << " s = " << nominal << " s / 2^" << max_cuts
                         << ")";
+                      m << ": the structure may have reached its limit load (use displacement "
+                           "control), or the increments or the tangent are poor (newton.csv has "
+                           "the residuals)";
                       if (!material_failure.empty())
-                        m << "; the material failed: " << material_failure;
-                      else
-                        m << "; the structure may have reached its limit load (use displacement "
-                             "control) or the tangent may be poor (newton.csv has the residuals)";
+                        m << "; the last failure was in the material: " << material_failure;
+                      m << ".";
                       fail(m.str(), t);
                     }
                   continue;

@@ -5,6 +5,7 @@
 #include <hysteron/base/parameters.h>
 #include <hysteron/scene/scene.h>
 
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 
@@ -256,6 +257,19 @@ namespace hysteron
       }
     return *it->second;
   }
+
+  template <int dim>
+  std::string
+  Scene<dim>::resolve_input_file(const std::string &name) const
+  {
+    std::error_code ec;
+    if (name.empty() || std::filesystem::exists(name, ec) || std::filesystem::path(name).is_absolute())
+      return name;
+    const auto beside = std::filesystem::path(options.parameter_file).parent_path() / name;
+    return std::filesystem::exists(beside, ec) ? beside.string() : name;
+  }
+
+
 
   template <int dim>
   std::vector<std::string>

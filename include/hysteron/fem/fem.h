@@ -17,6 +17,8 @@
 #include <hysteron/scene/point_data.h>
 #include <hysteron/scene/scene.h>
 
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -239,6 +241,19 @@ namespace hysteron
       force_level() const
       {
         return std::max(last_force_level, 1e-3 * force_scale);
+      }
+
+      /**
+       * Newton's target for the residual norm: Tolerance times the force level,
+       * but not below the round-off floor 64 eps sqrt(N) of a residual of N
+       * entries (a tighter request would iterate on noise).
+       */
+      double
+      residual_target() const
+      {
+        const double floor = 64 * std::numeric_limits<double>::epsilon() *
+                             std::sqrt(static_cast<double>(dof_handler.n_dofs()));
+        return std::max(newton_tolerance, floor) * force_level();
       }
 
       /// A row of newton.csv.

@@ -153,6 +153,20 @@ namespace hysteron
       return options.quiet;
     }
 
+    /// The parameter file of the run ("" when built in memory).
+    const std::string &
+    parameter_file() const
+    {
+      return options.parameter_file;
+    }
+
+    /**
+     * A file named in the parameter file: as given if it exists (relative to the
+     * working directory), else relative to the parameter file's directory.
+     */
+    std::string
+    resolve_input_file(const std::string &name) const;
+
     /// Progress and messages: rank 0 only, silent with --quiet.
     dealii::ConditionalOStream &
     console() const
