@@ -827,7 +827,8 @@ namespace hysteron
             }
           else
             {
-              SolverGMRES<Vector> gmres(control, SolverGMRES<Vector>::AdditionalData(100));
+              // Right preconditioning: the convergence test sees the true residual.
+              SolverGMRES<Vector> gmres(control, SolverGMRES<Vector>::AdditionalData(100, true));
               gmres.solve(system_matrix, du, system_rhs, amg);
             }
         }
