@@ -14,6 +14,7 @@ cd "$work"
 for scene in default table_2_1_kinematic table_2_1_mixed table_2_1_isotropic table_2_2_degradation; do
   "$exe" --quiet "$root/prm/$scene.prm"
 done
+mkdir -p fem_cantilever && (cd fem_cantilever && "$exe" --quiet "$root/prm/fem_cantilever_plastic.prm")
 
 $plot --x eps_xx --y sig_xx --xscale 100 --yscale 1e-6 --xlabel "strain $\\varepsilon_{xx}$ [%]" \
   --ylabel "stress $\\sigma_{xx}$ [MPa]" --title "default scene: steel, n = 8, m = 0.5" \
@@ -35,3 +36,8 @@ $plot --x t --y eta --xlabel "t [s]" --ylabel "stiffness degradation $\\eta$ [-]
 $plot --x t --y e_h --yscale 1e-6 --xlabel "t [s]" --ylabel 'dissipated energy $e_h$ [MJ/m$^3$]' \
   --title "Table 2-2: hysteretic energy" \
   --out "$fig/table_2_2_energy.png" output/table_2_2_degradation/history.csv:"e_h"
+
+# §5.1 with the FEM: tip load against tip deflection (displacement control, 30 mm at t = 1).
+$plot --x time --y tip_y --xscale 30 --yscale=-1e-3 --xlabel "tip deflection [mm]" \
+  --ylabel "tip load P [kN]" --title "FEM cantilever (§5.1): P_y = 20 kN, P_u = 30 kN (beam theory)" \
+  --out "$fig/fem_cantilever_plastic.png" fem_cantilever/output/reactions.csv:"FEM, Q2, h = 12.5 mm"
