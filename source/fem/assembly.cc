@@ -300,9 +300,7 @@ namespace hysteron
     {
       (void)t1;
       using namespace dealii;
-      const Scene<dim> &scene = this->get_scene();
-      MPI_Comm          comm  = scene.mpi_communicator();
-      double            work  = 0;
+      double work = 0;
       for (const auto &cell : triangulation.active_cell_iterators())
         if (cell->is_locally_owned())
           {
@@ -316,7 +314,7 @@ namespace hysteron
             h.stress.swap(h.trial_stress);
             h.state.swap(h.trial_state);
           }
-      internal_work += dealii::Utilities::MPI::sum(work, comm);
+      internal_work += work; // this rank's part (summed when a table row is written)
 
       Vector increment = u_trial;
       increment -= u;
@@ -334,17 +332,16 @@ namespace hysteron
           a_ghost = a;
         }
 
-      // External and boundary work (trapezoidal), the reactions of the new state.
-      external_work += 0.5 * (f_ext_old * increment + f_ext * increment);
+      // External and boundary work (trapezoidal, this rank's DoFs), the reactions of the new state.
+      for (const auto i : owned_dofs)
+        external_work += 0.5 * (f_ext_old(i) + f_ext(i)) * increment(i);
       Vector r = f_int;
       r += inertia;
       r -= f_ext;
-      double bw = 0;
       for (unsigned int k = 0; k < constrained_list.size(); ++k)
         if (owned_dofs.is_element(constrained_list[k]))
-          bw += 0.5 * (reaction_old(constrained_list[k]) + r(constrained_list[k])) *
-                increment(constrained_list[k]);
-      boundary_work += dealii::Utilities::MPI::sum(bw, comm);
+          boundary_work += 0.5 * (reaction_old(constrained_list[k]) + r(constrained_list[k])) *
+                           increment(constrained_list[k]);
       reaction_old = r;
       f_int_old    = f_int;
       f_ext_old    = f_ext;

@@ -969,11 +969,9 @@ namespace hysteron
       double t = 0;
       write_fields(t);
       write_table_rows(t);
-      const double output_interval = scene.output_control().interval;
-      const double probe_interval  = scene.output_control().probe_interval;
-      double       next_output     = output_interval;
-      double       next_row        = probe_interval;
-      const double eps             = 1e-12 * time.end_time;
+      PointData::Schedule rows(scene.output_control().probe_interval, time.end_time);
+      PointData::Schedule fields(scene.output_control().interval, time.end_time);
+      const double        eps = 1e-12 * time.end_time;
       Progress progress(scene.console(), "fem", time.end_time, scene.output_control().progress_interval);
 
       // The nominal step, and how often it has been halved.
@@ -1046,18 +1044,10 @@ namespace hysteron
             t = k * nominal;
           ++n_steps;
           const bool last = !(t < time.end_time - eps);
-          if (probe_interval == 0 || t >= next_row - eps || last)
-            {
-              write_table_rows(t);
-              while (probe_interval > 0 && next_row <= t + eps)
-                next_row += probe_interval;
-            }
-          if (output_interval == 0 || t >= next_output - eps || last)
-            {
-              write_fields(t);
-              while (output_interval > 0 && next_output <= t + eps)
-                next_output += output_interval;
-            }
+          if (rows.due(t, last))
+            write_table_rows(t);
+          if (fields.due(t, last))
+            write_fields(t);
           progress.update(n_steps, t);
         }
       progress.finish(n_steps, t);

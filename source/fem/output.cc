@@ -83,28 +83,8 @@ namespace hysteron
     Solver<dim>::open_tables()
     {
       const Scene<dim> &scene = this->get_scene();
-      if (!scene.is_root())
-        return;
-      const auto point = PointData::columns<dim>(state_names);
-      for (unsigned int i = 0; i < probes.size(); ++i)
-        {
-          std::vector<std::string> columns{"time"};
-          columns.insert(columns.end(), point.begin(), point.end());
-          probe_tables.push_back(std::make_unique<Output::CsvWriter>(
-            this->output_file("probe_" + std::to_string(i) + ".csv"), columns));
-        }
-      for (unsigned int i = 0; i < scene.output_control().average_regions.size(); ++i)
-        {
-          std::vector<std::string> columns{"time", "mass"};
-          columns.insert(columns.end(), point.begin(), point.end());
-          average_tables.push_back(std::make_unique<Output::CsvWriter>(
-            this->output_file("average_" + std::to_string(i) + ".csv"), columns));
-        }
-      energy_table = std::make_unique<Output::CsvWriter>(this->output_file("energy.csv"),
-                                                         PointData::energy_columns());
-      reaction_table = std::make_unique<Output::CsvWriter>(this->output_file("reactions.csv"),
-                                                           PointData::reaction_columns(scene));
-      if (analysis != Analysis::explicit_dynamics)
+      tables.open(scene, this->output_directory(), state_names);
+      if (scene.is_root() && analysis != Analysis::explicit_dynamics)
         newton_table = std::make_unique<Output::CsvWriter>(
           this->output_file("newton.csv"),
           std::vector<std::string>{"time", "step", "iteration", "residual", "force_level",
@@ -135,8 +115,8 @@ namespace hysteron
     std::vector<dealii::Tensor<1, dim>>
     Solver<dim>::reactions() const
     {
-      // The force of each constraint on the body: f_int + M a + C v - f_ext at its DoFs.
-      MPI_Comm                            comm = this->get_scene().mpi_communicator();
+      // The force of each constraint on the body: f_int + M a + C v - f_ext at its DoFs
+      // (this rank's part).
       std::vector<dealii::Tensor<1, dim>> r(dirichlet.size());
       for (unsigned int k = 0; k < constrained_list.size(); ++k)
         {
@@ -144,12 +124,8 @@ namespace hysteron
           if (owned_dofs.is_element(dof))
             r[constrained_set[k]][constrained_component[k]] += f_int(dof) + inertia(dof) - f_ext(dof);
         }
-      for (unsigned int s = 0; s < dirichlet.size(); ++s)
-        {
-          r[s] = dealii::Utilities::MPI::sum(r[s], comm);
-          if (s < wall_forces.size())
-            r[s] += wall_forces[s];
-        }
+      for (unsigned int s = 0; s < dirichlet.size() && s < wall_forces.size(); ++s)
+        r[s] += wall_forces[s];
       return r;
     }
 
@@ -162,17 +138,16 @@ namespace hysteron
       using namespace dealii;
       const Scene<dim>  &scene     = this->get_scene();
       MPI_Comm           comm      = scene.mpi_communicator();
-      const unsigned int n_values  = PointData::columns<dim>(state_names).size();
-      const unsigned int n_columns = 1 + n_values;
+      const unsigned int n_values  = tables.n_point_values();
       const auto        &regions   = scene.output_control().average_regions;
       const FEValuesExtractors::Vector displacement(0);
 
       // Probes: the owner of the cell gives position, displacement and velocity at
       // the point; the owner of the nearest quadrature point its stress and state.
-      std::vector<double> rows(probes.size() * n_columns, 0.0);
+      std::vector<double> rows(probes.size() * n_values, 0.0);
       for (unsigned int i = 0; i < probes.size(); ++i)
         {
-          double *row = rows.data() + i * n_columns + 1;
+          double *row = rows.data() + i * n_values;
           if (probes[i].has_q)
             {
               const CellHistory<dim> &h = *cell_history[probes[i].cell->active_cell_index()];
@@ -245,33 +220,8 @@ namespace hysteron
         for (const auto i : owned_dofs)
           kinetic += 0.5 * lumped_mass(i) * v(i) * v(i);
 
-      std::vector<double> sums{kinetic, strain_energy};
-      for (auto *w : {&rows, &sums, &averages})
-        if (!w->empty())
-          Utilities::MPI::sum(*w, comm, *w);
-      const auto r = reactions();
-      if (!scene.is_root())
-        return;
-      for (unsigned int i = 0; i < probes.size(); ++i)
-        {
-          std::vector<double> row(rows.begin() + i * n_columns, rows.begin() + (i + 1) * n_columns);
-          row[0] = t;
-          probe_tables[i]->add_row(row);
-        }
-      for (unsigned int i = 0; i < regions.size(); ++i)
-        {
-          const double       *avg = averages.data() + i * (1 + n_values);
-          std::vector<double> row{t, avg[0]};
-          for (unsigned int c = 0; c < n_values; ++c)
-            row.push_back(avg[0] > 0 ? avg[1 + c] / avg[0] : 0.0);
-          average_tables[i]->add_row(row);
-        }
-      energy_table->add_row(energy_log.row(t, sums[0], sums[1], internal_work, external_work, boundary_work));
-      std::vector<double> row{t};
-      for (const auto &force : r)
-        for (unsigned int d = 0; d < dim; ++d)
-          row.push_back(force[d]);
-      reaction_table->add_row(row);
+      tables.write(t, rows, averages, {{kinetic, strain_energy, internal_work, external_work, boundary_work}},
+                   reactions(), comm);
     }
 
 
@@ -406,13 +356,9 @@ namespace hysteron
     void
     Solver<dim>::commit_tables()
     {
-      for (auto &table : probe_tables)
-        table->commit();
-      for (auto &table : average_tables)
-        table->commit();
-      for (auto *table : {energy_table.get(), reaction_table.get(), newton_table.get()})
-        if (table)
-          table->commit();
+      tables.commit();
+      if (newton_table)
+        newton_table->commit();
     }
 
     template class Solver<2>;

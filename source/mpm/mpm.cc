@@ -744,30 +744,7 @@ namespace hysteron
     void
     Solver<dim>::open_tables()
     {
-      const Scene<dim> &scene = this->get_scene();
-      if (!scene.is_root())
-        return;
-      using PI = PropertiesIndex<dim>;
-      for (unsigned int i = 0; i < probes.size(); ++i)
-        {
-          std::vector<std::string> columns{"time"};
-          const auto               point = point_columns();
-          columns.insert(columns.end(), point.begin(), point.end());
-          probe_tables.push_back(std::make_unique<Output::CsvWriter>(
-            this->output_file("probe_" + std::to_string(i) + ".csv"), columns));
-        }
-      for (unsigned int i = 0; i < average_regions.size(); ++i)
-        {
-          std::vector<std::string> columns{"time", "mass"};
-          const auto               point = point_columns();
-          columns.insert(columns.end(), point.begin(), point.end());
-          average_tables.push_back(std::make_unique<Output::CsvWriter>(
-            this->output_file("average_" + std::to_string(i) + ".csv"), columns));
-        }
-      energy_table = std::make_unique<Output::CsvWriter>(this->output_file("energy.csv"),
-                                                         PointData::energy_columns());
-      reaction_table = std::make_unique<Output::CsvWriter>(this->output_file("reactions.csv"),
-                                                           PointData::reaction_columns(scene));
+      tables.open(this->get_scene(), this->output_directory(), state_names);
     }
 
 
@@ -850,14 +827,13 @@ namespace hysteron
       MPI_Comm          comm  = grid->mpi_communicator();
 
       // Probes: the owner fills its rows, the others contribute zeros.
-      const unsigned int  n_columns = 1 + point_columns().size();
-      std::vector<double> rows(probes.size() * n_columns, 0.0);
+      const unsigned int  n_values = tables.n_point_values();
+      std::vector<double> rows(probes.size() * n_values, 0.0);
       for (unsigned int i = 0; i < probes.size(); ++i)
         if (probes[i].local >= 0)
-          point_values(probes[i].local, rows.data() + i * n_columns + 1);
+          point_values(probes[i].local, rows.data() + i * n_values);
 
       // Mass-weighted averages over the points that started in each region.
-      const unsigned int  n_values = n_columns - 1;
       std::vector<double> averages(average_regions.size() * (1 + n_values), 0.0);
       std::vector<double> values(n_values);
       for (unsigned int i = 0; i < average_regions.size(); ++i)
@@ -890,44 +866,13 @@ namespace hysteron
                                                         std::size_t(s - group.begin) * group.n_state,
                                                       group.n_state));
           }
-      std::vector<double> sums{kinetic, strain_energy, internal_work, external_work, boundary_work};
-      std::vector<double> reaction_values;
-      for (const auto &r : reactions)
-        for (unsigned int d = 0; d < dim; ++d)
-          reaction_values.push_back(r[d]);
-      if (grid->is_parallel())
-        {
-          for (auto *v : {&rows, &sums, &reaction_values, &averages})
-            if (!v->empty())
-              MPI_Allreduce(MPI_IN_PLACE, v->data(), v->size(), MPI_DOUBLE, MPI_SUM, comm);
-        }
-      if (!scene.is_root())
-        return;
-      for (unsigned int i = 0; i < probes.size(); ++i)
-        {
-          std::vector<double> row(rows.begin() + i * n_columns, rows.begin() + (i + 1) * n_columns);
-          row[0] = t;
-          probe_tables[i]->add_row(row);
-        }
-      for (unsigned int i = 0; i < average_regions.size(); ++i)
-        {
-          const double       *a = averages.data() + i * (1 + n_values);
-          std::vector<double> row{t, a[0]};
-          for (unsigned int c = 0; c < n_values; ++c)
-            row.push_back(a[0] > 0 ? a[1 + c] / a[0] : 0.0);
-          average_tables[i]->add_row(row);
-        }
-      energy_table->add_row(energy_log.row(t, sums[0], sums[1], sums[2], sums[3], sums[4]));
-      std::vector<double> row{t};
-      const auto         &bodies = scene.body_descriptions();
-      for (unsigned int b = 0; b < boundaries.size(); ++b)
-        for (unsigned int d = 0; d < dim; ++d)
-          row.push_back(reaction_values[b * dim + d]);
+      // Reactions in the columns of reactions.csv: boundaries, then rigid bodies.
+      std::vector<Tensor<1, dim>> r(reactions.begin(), reactions.begin() + boundaries.size());
+      const auto                 &bodies = scene.body_descriptions();
       for (unsigned int b = 0; b < bodies.size(); ++b)
         if (bodies[b].rigid)
-          for (unsigned int d = 0; d < dim; ++d)
-            row.push_back(reaction_values[(boundaries.size() + b) * dim + d]);
-      reaction_table->add_row(row);
+          r.push_back(reactions[boundaries.size() + b]);
+      tables.write(t, rows, averages, {{kinetic, strain_energy, internal_work, external_work, boundary_work}}, r, comm);
     }
 
 
@@ -936,14 +881,7 @@ namespace hysteron
     void
     Solver<dim>::commit_tables()
     {
-      for (auto &table : probe_tables)
-        table->commit();
-      for (auto &table : average_tables)
-        table->commit();
-      if (energy_table)
-        energy_table->commit();
-      if (reaction_table)
-        reaction_table->commit();
+      tables.commit();
     }
 
 
@@ -1059,9 +997,7 @@ namespace hysteron
       internal_work = external_work = boundary_work = 0;
       write_fields(t);
       write_table_rows(t);
-      const double output_interval = scene.output_control().interval;
-      double       next_output     = output_interval;
-      double       next_row        = probe_interval;
+      PointData::Schedule rows(probe_interval, time.end_time), fields(scene.output_control().interval, time.end_time);
       Progress     progress(scene.console(), "mpm", time.end_time, scene.output_control().progress_interval);
       const double eps = 1e-12 * time.end_time;
       while (t < time.end_time - eps)
@@ -1116,18 +1052,10 @@ namespace hysteron
             }
 
           const bool last = !(t < time.end_time - eps);
-          if (probe_interval == 0 || t >= next_row - eps || last)
-            {
-              write_table_rows(t);
-              while (probe_interval > 0 && next_row <= t + eps)
-                next_row += probe_interval;
-            }
-          if (output_interval == 0 || t >= next_output - eps || last)
-            {
-              write_fields(t);
-              while (output_interval > 0 && next_output <= t + eps)
-                next_output += output_interval;
-            }
+          if (rows.due(t, last))
+            write_table_rows(t);
+          if (fields.due(t, last))
+            write_fields(t);
           progress.update(n_steps, t);
         }
       progress.finish(n_steps, t);

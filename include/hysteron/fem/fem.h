@@ -15,6 +15,7 @@
 #include <hysteron/geometry/region.h>
 #include <hysteron/scene/method.h>
 #include <hysteron/scene/point_data.h>
+#include <hysteron/scene/tables.h>
 #include <hysteron/scene/scene.h>
 
 #include <cmath>
@@ -298,7 +299,7 @@ namespace hysteron
       [[noreturn]] void
       fail(const std::string &what, const double t);
 
-      /// The reaction (force of the constraint on the body) of every Dirichlet set.
+      /// The reaction (force of the constraint on the body) of every Dirichlet set: this rank's part.
       std::vector<dealii::Tensor<1, dim>>
       reactions() const;
 
@@ -361,9 +362,9 @@ namespace hysteron
       std::string                                      material_failure;
       std::vector<Probe>                               probes;
       std::unique_ptr<Output::FieldWriter>             field_writer;
-      std::vector<std::unique_ptr<Output::CsvWriter>>  probe_tables, average_tables;
-      std::unique_ptr<Output::CsvWriter>               energy_table, reaction_table, newton_table;
-      PointData::EnergyLog                             energy_log;
+      PointData::Tables<dim>                           tables;
+      std::unique_ptr<Output::CsvWriter>               newton_table;
+      /// Work of this rank's cells and DoFs since t = 0 (summed when a row is written).
       double internal_work = 0, external_work = 0, boundary_work = 0;
       unsigned long n_steps = 0, n_newton = 0, n_cuts = 0, n_linear = 0;
       unsigned int  n_outputs = 0;

@@ -10,6 +10,7 @@
 #include <hysteron/mpm/particles.h>
 #include <hysteron/scene/method.h>
 #include <hysteron/scene/point_data.h>
+#include <hysteron/scene/tables.h>
 #include <hysteron/scene/scene.h>
 
 #include <cmath>
@@ -222,10 +223,7 @@ namespace hysteron
       unsigned int                                  n_outputs = 0;
       unsigned int                                  n_rebuilds = 0;
       std::unique_ptr<Output::FieldWriter>          field_writer;
-      std::vector<std::unique_ptr<Output::CsvWriter>> probe_tables;
-      std::vector<std::unique_ptr<Output::CsvWriter>> average_tables;
-      std::unique_ptr<Output::CsvWriter>            energy_table;
-      std::unique_ptr<Output::CsvWriter>            reaction_table;
+      PointData::Tables<dim>                        tables;
       std::vector<std::string>                      state_names;
       std::vector<unsigned int>                     group_of_body;
       std::vector<std::vector<dealii::Point<dim>>>  body_points; ///< set-up only
@@ -233,7 +231,6 @@ namespace hysteron
       unsigned int                                  current_group_key = 0;
       unsigned int                                  n_properties      = 0;
       std::vector<unsigned long>                    load_count; ///< points per load (index 0: none)
-      PointData::EnergyLog                          energy_log;
       dealii::types::particle_index                 n_global_particles = 0;
     };
   } // namespace MPM

@@ -1,0 +1,101 @@
+#ifndef hysteron_scene_tables_h
+#define hysteron_scene_tables_h
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/tensor.h>
+
+#include <hysteron/base/output.h>
+#include <hysteron/scene/point_data.h>
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace hysteron
+{
+  namespace PointData
+  {
+    /**
+     * The time tables of a field method (see point_data.h for their columns):
+     * probe_<i>.csv, average_<i>.csv, energy.csv and reactions.csv, opened on
+     * rank 0 and written from the partial sums of every rank (one reduction per
+     * row, none on one rank).
+     */
+    template <int dim>
+    class Tables
+    {
+    public:
+      /// Open the tables in @p directory (rank 0): one probe table per probe point of
+      /// the scene, one average table per average region.
+      void
+      open(const Scene<dim>               &scene,
+           const std::string              &directory,
+           const std::vector<std::string> &state_names);
+
+      /// The number of values of a point (the probe columns without `time`).
+      unsigned int
+      n_point_values() const
+      {
+        return n_values;
+      }
+
+      /**
+       * Add a row to every table at time @p t. Each rank passes its partial
+       * sums: @p probes (n_probes x n_point_values(): the rank that owns a
+       * probe's point fills it, the others leave zeros), @p averages (per region:
+       * mass, then the mass-weighted sums of the point values), @p energies
+       * (kinetic, strain energy, internal, external and boundary work) and
+       * @p reactions (one per column pair of reactions.csv). The arrays are
+       * summed in place.
+       */
+      void
+      write(const double                         t,
+            std::vector<double>                 &probes,
+            std::vector<double>                 &averages,
+            std::array<double, 5>                energies,
+            std::vector<dealii::Tensor<1, dim>>  reactions,
+            const MPI_Comm                       comm);
+
+      /// Commit (rename) every table (rank 0).
+      void
+      commit();
+
+    private:
+      std::vector<std::unique_ptr<Output::CsvWriter>> probe_tables, average_tables;
+      std::unique_ptr<Output::CsvWriter>              energy_table, reaction_table;
+      EnergyLog                                       energy_log;
+      unsigned int                                    n_values = 0;
+    };
+
+    /**
+     * When outputs are due in a time-stepping run: every step for an interval
+     * of 0, else each time t passes the next multiple of the interval, and on
+     * the last step.
+     */
+    class Schedule
+    {
+    public:
+      Schedule(const double interval, const double end_time)
+        : interval(interval)
+        , next(interval)
+        , eps(1e-12 * end_time)
+      {}
+
+      /// After a step that ended at @p t (the last one if @p last): is an output due?
+      bool
+      due(const double t, const bool last)
+      {
+        const bool now = interval == 0 || t >= next - eps || last;
+        while (interval > 0 && next <= t + eps)
+          next += interval;
+        return now;
+      }
+
+    private:
+      double interval, next, eps;
+    };
+  } // namespace PointData
+} // namespace hysteron
+
+#endif

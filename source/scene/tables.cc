@@ -1,0 +1,114 @@
+#include <deal.II/base/mpi.h>
+
+#include <hysteron/scene/scene.h>
+#include <hysteron/scene/tables.h>
+
+namespace hysteron
+{
+  namespace PointData
+  {
+    template <int dim>
+    void
+    Tables<dim>::open(const Scene<dim>               &scene,
+                      const std::string              &directory,
+                      const std::vector<std::string> &state_names)
+    {
+      const auto point = columns<dim>(state_names);
+      n_values         = point.size();
+      if (!scene.is_root())
+        return;
+      const auto file = [&](const std::string &name) { return directory + "/" + name; };
+      for (unsigned int i = 0; i < scene.output_control().probe_points.size(); ++i)
+        {
+          std::vector<std::string> c{"time"};
+          c.insert(c.end(), point.begin(), point.end());
+          probe_tables.push_back(
+            std::make_unique<Output::CsvWriter>(file("probe_" + std::to_string(i) + ".csv"), c));
+        }
+      for (unsigned int i = 0; i < scene.output_control().average_regions.size(); ++i)
+        {
+          std::vector<std::string> c{"time", "mass"};
+          c.insert(c.end(), point.begin(), point.end());
+          average_tables.push_back(
+            std::make_unique<Output::CsvWriter>(file("average_" + std::to_string(i) + ".csv"), c));
+        }
+      energy_table   = std::make_unique<Output::CsvWriter>(file("energy.csv"), energy_columns());
+      reaction_table = std::make_unique<Output::CsvWriter>(file("reactions.csv"), reaction_columns(scene));
+    }
+
+
+
+    template <int dim>
+    void
+    Tables<dim>::write(const double                        t,
+                       std::vector<double>                &probes,
+                       std::vector<double>                &averages,
+                       std::array<double, 5>               energies,
+                       std::vector<dealii::Tensor<1, dim>> reactions,
+                       const MPI_Comm                      comm)
+    {
+      // One reduction of everything, and none on one rank.
+      if (dealii::Utilities::MPI::n_mpi_processes(comm) > 1)
+        {
+          std::vector<double> all(probes);
+          all.insert(all.end(), averages.begin(), averages.end());
+          all.insert(all.end(), energies.begin(), energies.end());
+          for (const auto &r : reactions)
+            for (unsigned int d = 0; d < dim; ++d)
+              all.push_back(r[d]);
+          MPI_Allreduce(MPI_IN_PLACE, all.data(), all.size(), MPI_DOUBLE, MPI_SUM, comm);
+          auto p = all.begin();
+          std::copy(p, p + probes.size(), probes.begin());
+          p += probes.size();
+          std::copy(p, p + averages.size(), averages.begin());
+          p += averages.size();
+          std::copy(p, p + 5, energies.begin());
+          p += 5;
+          for (auto &r : reactions)
+            for (unsigned int d = 0; d < dim; ++d)
+              r[d] = *p++;
+        }
+      if (dealii::Utilities::MPI::this_mpi_process(comm) != 0)
+        return;
+      for (unsigned int i = 0; i < probe_tables.size(); ++i)
+        {
+          std::vector<double> row{t};
+          row.insert(row.end(), probes.begin() + i * n_values, probes.begin() + (i + 1) * n_values);
+          probe_tables[i]->add_row(row);
+        }
+      for (unsigned int i = 0; i < average_tables.size(); ++i)
+        {
+          const double       *a = averages.data() + i * (1 + n_values);
+          std::vector<double> row{t, a[0]};
+          for (unsigned int c = 0; c < n_values; ++c)
+            row.push_back(a[0] > 0 ? a[1 + c] / a[0] : 0.0);
+          average_tables[i]->add_row(row);
+        }
+      energy_table->add_row(
+        energy_log.row(t, energies[0], energies[1], energies[2], energies[3], energies[4]));
+      std::vector<double> row{t};
+      for (const auto &r : reactions)
+        for (unsigned int d = 0; d < dim; ++d)
+          row.push_back(r[d]);
+      reaction_table->add_row(row);
+    }
+
+
+
+    template <int dim>
+    void
+    Tables<dim>::commit()
+    {
+      for (auto &table : probe_tables)
+        table->commit();
+      for (auto &table : average_tables)
+        table->commit();
+      for (auto *table : {energy_table.get(), reaction_table.get()})
+        if (table)
+          table->commit();
+    }
+
+    template class Tables<2>;
+    template class Tables<3>;
+  } // namespace PointData
+} // namespace hysteron
