@@ -99,8 +99,8 @@ namespace hysteron
                           "false",
                           Patterns::Bool(),
                           "Write quadrature_points.csv at the end: one row per quadrature point "
-                          "(cell, body, then the probe columns: position, displacement, velocity, "
-                          "stress, von Mises stress, strain, material state).");
+                          "(body, then the probe columns: position, displacement, velocity, "
+                          "stress, von Mises stress, strain, material state), sorted by position.");
 
         prm.enter_subsection("Mesh");
         {
@@ -119,6 +119,12 @@ namespace hysteron
                             Patterns::Double(),
                             "Target cell size h [m] of the generated mesh, > 0 (not used with "
                             "`file`).");
+          prm.declare_entry("Curved boundary resolution",
+                            "0",
+                            Patterns::Double(),
+                            "unstructured: the segment length [m] of curved boundaries (disks "
+                            "become regular polygons with sides of about this length), >= 0; 0: "
+                            "half the cell size. The mesh is graded towards finer boundaries.");
           prm.declare_entry("Refinements",
                             "0",
                             Patterns::Integer(0, 10),
@@ -228,6 +234,7 @@ namespace hysteron
         generator   = s.get("Generator");
         cell_size   = s.get_non_negative("Cell size");
         refinements = s.get_integer("Refinements");
+        boundary_resolution = s.get_non_negative("Curved boundary resolution");
         mesh_file   = scene.resolve_input_file(dealii::Utilities::trim(s.get("Mesh file")));
         if (generator == "file")
           {
@@ -382,7 +389,9 @@ namespace hysteron
                      Geometry::structured_mesh<dim>(shapes, cell_size, "FEM/Mesh/Cell size") :
                      // The generator's size bound is that of its triangles; each is split
                      // into three quadrilaterals with edges of at most half of it.
-                     Geometry::unstructured_mesh(shapes, 2 * cell_size, "FEM/Mesh/Cell size");
+                     Geometry::unstructured_mesh(shapes, 2 * cell_size, "FEM/Mesh/Cell size",
+                                                 boundary_resolution > 0 ? boundary_resolution :
+                                                                           0.5 * cell_size);
           else
             mesh = Geometry::structured_mesh<dim>(shapes, cell_size, "FEM/Mesh/Cell size");
           if (kind == "structured")

@@ -386,8 +386,10 @@ namespace hysteron
     CoarseMesh<2>
     unstructured_mesh(const std::vector<const Region<2> *> &bodies,
                       const double                           h,
-                      const std::string                     &where)
+                      const std::string                     &where,
+                      const double                           boundary_h_in)
     {
+      const double boundary_h = boundary_h_in > 0 ? boundary_h_in : h;
       using Kind          = Region<2>::Kind;
       const auto [lo, hi] = checked_bounding_box(bodies, h, where);
 
@@ -398,9 +400,9 @@ namespace hysteron
         {
           for (const auto &q : bodies[i]->get_primitives())
             if (q.kind == Kind::disk)
-              require(2 * M_PI * q.p[2] / h <= 1e6, where,
+              require(2 * M_PI * q.p[2] / boundary_h <= 1e6, where,
                       body_name(bodies, i) + ": a disk of radius " + to_string(q.p[2]) +
-                        " needs more than 1e6 sides at h = " + to_string(h));
+                        " needs more than 1e6 sides at h = " + to_string(boundary_h));
           const auto box = bodies[i]->bounding_box().get_boundary_points();
           area_estimate += (bodies[i]->get_program().size() == 1 ?
                               bodies[i]->volume_estimate() :
@@ -415,7 +417,7 @@ namespace hysteron
       std::vector<Region<2>> polygonized;
       polygonized.reserve(bodies.size());
       for (const auto *body : bodies)
-        polygonized.push_back(body->polygonized(h));
+        polygonized.push_back(body->polygonized(boundary_h));
       std::vector<const Region<2> *> classifiers;
       for (const auto &p : polygonized)
         classifiers.push_back(&p);
@@ -424,7 +426,7 @@ namespace hysteron
       Triangulation cdt;
       VertexHandle  hint;
       for (const auto *body : bodies)
-        for (auto segment : body->boundary_segments(h))
+        for (auto segment : body->boundary_segments(boundary_h))
           {
             if (!clip(segment[0], segment[1], lo, hi))
               continue;

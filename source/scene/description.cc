@@ -204,7 +204,7 @@ namespace hysteron
                           "",
                           Patterns::Anything(),
                           "Alternatively (or additionally) the nodes inside this region [m] "
-                          "(fixed and velocity types); see doc/geometry.md.");
+                          "(fixed, velocity and displacement types); see doc/geometry.md.");
         prm.declare_entry("Components",
                           "all",
                           Patterns::Anything(),

@@ -157,6 +157,7 @@ namespace hysteron
       double        maximum_cfl  = 1;
       std::string   generator    = "automatic";
       double        cell_size    = 0;
+      double        boundary_resolution = 0; ///< segment length of curved boundaries, 0: h/2
       unsigned int  refinements  = 0;
       std::string   mesh_file;
       double        newton_tolerance = 1e-8;

@@ -64,6 +64,10 @@ namespace hysteron
      * through the whole grid (tensor product): a flange of thickness t < h makes
      * a layer of cells of height t across the box.
      *
+     * @p boundary_h (0: h) is the segment length of curved boundaries (disks as
+     * regular polygons with n_disk_sides(r, boundary_h) sides); a value below h
+     * resolves them more finely than the cells (graded refinement along them).
+     *
      * Throws InputError(@p where, ...) for h <= 0, no body, a null, empty or
      * unbounded body, a tensor grid of more than 5e6 cells, or if a body (or the
      * union) gets no cell.
@@ -116,6 +120,10 @@ namespace hysteron
      * than h (nearly touching primitives, tangencies) are resolved by graded local
      * refinement.
      *
+     * @p boundary_h (0: h) is the segment length of curved boundaries (disks as
+     * regular polygons with n_disk_sides(r, boundary_h) sides); a value below h
+     * resolves them more finely than the cells (graded refinement along them).
+     *
      * Throws InputError(@p where, ...) for h <= 0, no body, a null, empty or
      * unbounded body, a disk needing more than 1e6 sides, an estimated mesh of
      * more than 5e6 cells (estimated from the bounding boxes), a refinement that
@@ -126,7 +134,8 @@ namespace hysteron
     CoarseMesh<2>
     unstructured_mesh(const std::vector<const Region<2> *> &bodies,
                       const double                           h,
-                      const std::string                     &where);
+                      const std::string                     &where,
+                      const double                           boundary_h = 0);
   } // namespace Geometry
 } // namespace hysteron
 
