@@ -33,7 +33,9 @@ namespace hysteron
   void
   Progress::finish(const unsigned long step, const double time)
   {
-    print(step, time);
+    // Once, unless update() has just printed this very step.
+    if (!(printed && step == last_step))
+      print(step, time);
   }
 
   void
@@ -49,5 +51,7 @@ namespace hysteron
     else
       line << "  wall " << std::setprecision(2) << elapsed << " s";
     out << line.str() << std::endl;
+    printed   = true;
+    last_step = step;
   }
 } // namespace hysteron

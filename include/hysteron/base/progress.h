@@ -39,6 +39,8 @@ namespace hysteron
     double                      interval;
     dealii::Timer               timer;
     double                      last_print = 0;
+    bool                        printed    = false;
+    unsigned long               last_step  = 0;
   };
 } // namespace hysteron
 

@@ -168,6 +168,7 @@ namespace hysteron
       double        rayleigh_mass = 0, rayleigh_stiffness = 0;
       LinearSolver  solver_type = LinearSolver::automatic;
       unsigned long direct_limit = 100000;
+      std::string   direct_package = "Amesos_Klu";
       double        solver_tolerance = 1e-10;
       unsigned int  solver_max_iterations = 5000;
       bool          quadrature_table = false;
