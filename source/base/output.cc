@@ -156,6 +156,24 @@ namespace hysteron
       ++counter;
     }
 
+    void
+    FieldWriter::write_serial(const std::function<void(std::ostream &)> &writer, const double time)
+    {
+      const std::string record = base_name + "-" + dealii::Utilities::int_to_string(counter, 5) + ".vtu";
+      times_and_names.emplace_back(time, record);
+      ++counter;
+      if (dealii::Utilities::MPI::this_mpi_process(comm) != 0)
+        return;
+      {
+        AtomicFile file(directory + "/" + record);
+        writer(file.stream());
+        file.commit();
+      }
+      AtomicFile file(directory + "/" + base_name + ".pvd");
+      dealii::DataOutBase::write_pvd_record(file.stream(), times_and_names);
+      file.commit();
+    }
+
     template void
     FieldWriter::write<1, 2>(const dealii::DataOutInterface<1, 2> &, double);
     template void

@@ -12,6 +12,7 @@
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_solver.h>
 
+#include <hysteron/base/newton.h>
 #include <hysteron/base/parameters.h>
 #include <hysteron/base/progress.h>
 #include <hysteron/fem/fem.h>
@@ -139,27 +140,7 @@ namespace hysteron
         prm.leave_subsection();
 
         prm.enter_subsection("Newton");
-        {
-          prm.declare_entry("Tolerance",
-                            "1e-8",
-                            Patterns::Double(),
-                            "Convergence when the residual norm is below this fraction of the "
-                            "force level max(|f_int|, |f_ext|, |inertia|), > 0.");
-          prm.declare_entry("Maximum iterations",
-                            "25",
-                            Patterns::Integer(1),
-                            "Newton iterations per increment before the increment is cut.");
-          prm.declare_entry("Line search",
-                            "true",
-                            Patterns::Bool(),
-                            "Backtracking line search on the residual norm (halving, up to 6 "
-                            "times) when a full Newton step does not reduce it.");
-          prm.declare_entry("Maximum increment cuts",
-                            "8",
-                            Patterns::Integer(0, 30),
-                            "How often a failing increment may be halved before the run stops "
-                            "with an error (the last good state is written).");
-        }
+        NewtonParameters::declare_parameters(prm);
         prm.leave_subsection();
 
         prm.enter_subsection("Dynamics");
@@ -268,11 +249,7 @@ namespace hysteron
                   "or a Gmsh file");
       }
       {
-        Section s(prm, {"FEM", "Newton"});
-        newton_tolerance      = s.get_positive("Tolerance");
-        newton_max_iterations = s.get_integer("Maximum iterations");
-        line_search           = s.get_bool("Line search");
-        max_cuts              = s.get_integer("Maximum increment cuts");
+        newton.parse_parameters(Section(prm, {"FEM", "Newton"}));
       }
       {
         Section s(prm, {"FEM", "Dynamics"});
@@ -887,61 +864,61 @@ namespace hysteron
       ghost = u_trial;
       if (!assemble(ghost, t1, dt, Assemble::residual_and_matrix))
         return false;
-      double residual = system_rhs.l2_norm();
-      log_newton(t1, dt, 0, residual, 1.0);
+      log_newton(t1, dt, 0, system_rhs.l2_norm(), 1.0);
 
-      for (unsigned int iteration = 1; iteration <= newton_max_iterations; ++iteration)
+      // The iterations (line search, round-off floor): base/newton.h.
+      struct Problem : NewtonProblem
+      {
+        Solver &s;
+        double  t1, dt;
+        Vector &du, &ghost;
+        Vector  start;
+        Problem(Solver &s, double t1, double dt, Vector &du, Vector &ghost)
+          : s(s), t1(t1), dt(dt), du(du), ghost(ghost), start(du)
+        {}
+        bool
+        evaluate(const bool matrix) override
         {
-          if (!std::isfinite(residual))
-            return false;
-          if (residual <= residual_target())
-            {
-              n_newton += iteration;
-              return true;
-            }
-          du = 0;
-          n_linear += solve_linear(du);
-          constraints.distribute(du);
-          Vector start = u_trial;
-          double alpha = 1.0, trial = 0;
-          bool   ok    = true;
-          // Below 1e-10 of the force level the residual is round-off: full steps only.
-          const bool noise = residual <= 1e-10 * force_level();
-          for (unsigned int k = 0; k <= (line_search && !noise ? 6u : 0u); ++k)
-            {
-              u_trial = start;
-              u_trial.add(alpha, du);
-              ghost = u_trial;
-              ok    = assemble(ghost, t1, dt, k == 0 ? Assemble::residual_and_matrix : Assemble::forces);
-              trial = ok ? system_rhs.l2_norm() : std::numeric_limits<double>::infinity();
-              if ((ok && trial <= (1 - 1e-4 * alpha) * residual) || !line_search || noise)
-                break;
-              alpha *= 0.5;
-            }
-          if (!ok && !line_search)
-            return false;
-          if (alpha < 1.0 || !ok)
-            {
-              // The accepted iterate (the last tried, possibly not a descent) with its matrix.
-              if (!ok)
-                return false;
-              ghost = u_trial;
-              if (!assemble(ghost, t1, dt, Assemble::residual_and_matrix))
-                return false;
-              trial = system_rhs.l2_norm();
-            }
-          // Converged to round-off: no progress any more below 1e-10 of the force level.
-          const bool stagnated = trial > 0.5 * residual && trial <= 1e-10 * force_level();
-          residual             = trial;
-          log_newton(t1, dt, iteration, residual, alpha);
-          if (stagnated && std::isfinite(residual))
-            {
-              n_newton += iteration;
-              return true;
-            }
+          ghost = s.u_trial;
+          return s.assemble(ghost, t1, dt, matrix ? Assemble::residual_and_matrix : Assemble::forces);
         }
-      n_newton += newton_max_iterations;
-      return residual <= residual_target();
+        double
+        residual() const override
+        {
+          return s.system_rhs.l2_norm();
+        }
+        double
+        force_level() const override
+        {
+          return s.force_level();
+        }
+        void
+        solve_correction() override
+        {
+          du = 0;
+          s.n_linear += s.solve_linear(du);
+          s.constraints.distribute(du);
+        }
+        void
+        remember_start() override
+        {
+          start = s.u_trial;
+        }
+        void
+        move(const double alpha) override
+        {
+          s.u_trial = start;
+          s.u_trial.add(alpha, du);
+        }
+        void
+        log(const unsigned int iteration, const double residual, const double alpha) override
+        {
+          s.log_newton(t1, dt, iteration, residual, alpha);
+        }
+      } problem(*this, t1, dt, du, ghost);
+      const unsigned int iterations = newton_iterate(problem, newton, residual_floor());
+      n_newton += iterations > 0 ? iterations : newton.max_iterations;
+      return iterations > 0;
     }
 
 
@@ -1030,12 +1007,12 @@ namespace hysteron
                 {
                   ++n_cuts;
                   successes = 0;
-                  if (++level > max_cuts)
+                  if (++level > newton.max_cuts)
                     {
                       std::ostringstream m;
                       m << "fem: Newton did not converge in the increment from t = " << t
-                        << " s to " << t + dt << " s after " << max_cuts
-                        << " cuts (increment " << dt << " s = " << nominal << " s / 2^" << max_cuts
+                        << " s to " << t + dt << " s after " << newton.max_cuts
+                        << " cuts (increment " << dt << " s = " << nominal << " s / 2^" << newton.max_cuts
                         << ")";
                       m << ": the structure may have reached its limit load (use displacement "
                            "control), or the increments or the tangent are poor (newton.csv has "

@@ -83,7 +83,7 @@ namespace hysteron
     Solver<dim>::open_tables()
     {
       const Scene<dim> &scene = this->get_scene();
-      tables.open(scene, this->output_directory(), state_names);
+      tables.open(scene, this->output_directory(), PointData::columns<dim>(state_names));
       if (scene.is_root() && analysis != Analysis::explicit_dynamics)
         newton_table = std::make_unique<Output::CsvWriter>(
           this->output_file("newton.csv"),

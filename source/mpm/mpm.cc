@@ -744,7 +744,7 @@ namespace hysteron
     void
     Solver<dim>::open_tables()
     {
-      tables.open(this->get_scene(), this->output_directory(), state_names);
+      tables.open(this->get_scene(), this->output_directory(), PointData::columns<dim>(state_names));
     }
 
 

@@ -11,9 +11,8 @@ namespace hysteron
     void
     Tables<dim>::open(const Scene<dim>               &scene,
                       const std::string              &directory,
-                      const std::vector<std::string> &state_names)
+                      const std::vector<std::string> &point)
     {
-      const auto point = columns<dim>(state_names);
       n_values         = point.size();
       if (!scene.is_root())
         return;

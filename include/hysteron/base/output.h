@@ -5,6 +5,7 @@
 #include <deal.II/base/mpi.h>
 
 #include <fstream>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -109,6 +110,13 @@ namespace hysteron
       template <int dim, int spacedim>
       void
       write(const dealii::DataOutInterface<dim, spacedim> &data_out, double time);
+
+      /**
+       * A VTU file that @p writer produces whole (a method's own cells, e.g. the
+       * RBSN's polygons): written by rank 0 as "<base>-<step>.vtu", then the PVD.
+       */
+      void
+      write_serial(const std::function<void(std::ostream &)> &writer, double time);
 
       /// The (time, file) list written so far.
       const std::vector<std::pair<double, std::string>> &

@@ -11,6 +11,7 @@
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 
+#include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>
 #include <hysteron/geometry/region.h>
 #include <hysteron/scene/method.h>
@@ -160,10 +161,7 @@ namespace hysteron
       double        boundary_resolution = 0; ///< segment length of curved boundaries, 0: h/2
       unsigned int  refinements  = 0;
       std::string   mesh_file;
-      double        newton_tolerance = 1e-8;
-      unsigned int  newton_max_iterations = 25;
-      bool          line_search = true;
-      unsigned int  max_cuts   = 8;
+      NewtonParameters newton;
       double        hht_alpha  = 0;
       double        rayleigh_mass = 0, rayleigh_stiffness = 0;
       LinearSolver  solver_type = LinearSolver::automatic;
@@ -246,17 +244,13 @@ namespace hysteron
         return std::max(last_force_level, 1e-3 * force_scale);
       }
 
-      /**
-       * Newton's target for the residual norm: Tolerance times the force level,
-       * but not below the round-off floor 64 eps sqrt(N) of a residual of N
-       * entries (a tighter request would iterate on noise).
-       */
+      /// The round-off floor 64 eps sqrt(N) of a residual of N entries, relative to
+      /// the force level (a tighter tolerance would iterate on noise).
       double
-      residual_target() const
+      residual_floor() const
       {
-        const double floor = 64 * std::numeric_limits<double>::epsilon() *
-                             std::sqrt(static_cast<double>(dof_handler.n_dofs()));
-        return std::max(newton_tolerance, floor) * force_level();
+        return 64 * std::numeric_limits<double>::epsilon() *
+               std::sqrt(static_cast<double>(dof_handler.n_dofs()));
       }
 
       /// A row of newton.csv.

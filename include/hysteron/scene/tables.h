@@ -27,11 +27,12 @@ namespace hysteron
     {
     public:
       /// Open the tables in @p directory (rank 0): one probe table per probe point of
-      /// the scene, one average table per average region.
+      /// the scene, one average table per average region, with the @p point_columns
+      /// (PointData::columns() for material points and quadrature points).
       void
       open(const Scene<dim>               &scene,
            const std::string              &directory,
-           const std::vector<std::string> &state_names);
+           const std::vector<std::string> &point_columns);
 
       /// The number of values of a point (the probe columns without `time`).
       unsigned int

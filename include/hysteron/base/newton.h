@@ -1,0 +1,83 @@
+#ifndef hysteron_base_newton_h
+#define hysteron_base_newton_h
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <hysteron/base/parameters.h>
+
+namespace hysteron
+{
+  /// `subsection Newton` of an implicit method (FEM, RBSN).
+  struct NewtonParameters
+  {
+    double       tolerance      = 1e-8;
+    unsigned int max_iterations = 25;
+    bool         line_search    = true;
+    unsigned int max_cuts       = 8;
+
+    /// Declare the entries in the current subsection.
+    static void
+    declare_parameters(dealii::ParameterHandler &prm);
+
+    void
+    parse_parameters(const Section &section);
+  };
+
+  /**
+   * What Newton's method needs from a discretisation: the current iterate
+   * u_k, its residual r(u_k) on the free DoFs (with the tangent when asked) and
+   * the solution of the linearised system for the correction du.
+   */
+  class NewtonProblem
+  {
+  public:
+    virtual ~NewtonProblem() = default;
+
+    /// Evaluate at the current iterate (residual, and the matrix if @p matrix);
+    /// false if it failed (a material, a non-finite value).
+    virtual bool
+    evaluate(const bool matrix) = 0;
+
+    /// The norm of the residual of the last evaluation.
+    virtual double
+    residual() const = 0;
+
+    /// The force level the residual is measured against (> 0 once anything is loaded).
+    virtual double
+    force_level() const = 0;
+
+    /// du from the matrix and residual of the last evaluation with a matrix.
+    virtual void
+    solve_correction() = 0;
+
+    /// u_k = u_start + alpha du (u_start: the iterate when du was computed).
+    virtual void
+    move(const double alpha) = 0;
+
+    /// Remember the current iterate as u_start.
+    virtual void
+    remember_start() = 0;
+
+    /// A row of the iteration log.
+    virtual void
+    log(const unsigned int iteration, const double residual, const double alpha) = 0;
+  };
+
+  /**
+   * Newton iterations from an evaluated iterate (with its matrix): converged
+   * when the residual is at most max(Tolerance, @p relative_floor) times the
+   * force level (the floor: the round-off level of the residual, e.g.
+   * 64 eps sqrt(N) for N DoFs); each correction is backtracked
+   * (halving, up to 6 times) while it does not reduce the residual by the
+   * Armijo factor; below 1e-10 of the force level the residual is round-off, so
+   * full steps are taken and a residual that stops falling counts as
+   * converged. Returns the iterations needed (>= 1), or 0 if the iteration did
+   * not converge or an evaluation failed.
+   */
+  unsigned int
+  newton_iterate(NewtonProblem          &problem,
+                 const NewtonParameters &parameters,
+                 const double            relative_floor);
+} // namespace hysteron
+
+#endif
