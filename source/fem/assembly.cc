@@ -331,6 +331,14 @@ namespace hysteron
           v_ghost = v;
           a_ghost = a;
         }
+      else if (analysis == Analysis::quasi_static && dt > 0)
+        {
+          // The rate of the load path (t is the load parameter): what the probes
+          // report as velocity, comparable with a slow dynamic run. No kinetic energy.
+          v = increment;
+          v *= 1 / dt;
+          v_ghost = v;
+        }
 
       // External and boundary work (trapezoidal, this rank's DoFs), the reactions of the new state.
       for (const auto i : owned_dofs)

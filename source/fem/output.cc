@@ -170,8 +170,7 @@ namespace hysteron
               fv.reinit(probes[i].dof_cell);
               std::vector<Tensor<1, dim>> uu(1), vv(1);
               fv[displacement].get_function_values(u_ghost, uu);
-              if (analysis != Analysis::quasi_static)
-                fv[displacement].get_function_values(v_ghost, vv);
+              fv[displacement].get_function_values(v_ghost, vv);
               for (unsigned int d = 0; d < dim; ++d)
                 {
                   row[d]           = probes[i].point[d] + uu[0][d];
@@ -193,8 +192,7 @@ namespace hysteron
             const CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
             fv.reinit(cell);
             fv[displacement].get_function_values(u_ghost, uq);
-            if (analysis != Analysis::quasi_static)
-              fv[displacement].get_function_values(v_ghost, vq);
+            fv[displacement].get_function_values(v_ghost, vq);
             const double rho = h.material->density();
             for (unsigned int q = 0; q < n_q; ++q)
               {
@@ -277,9 +275,8 @@ namespace hysteron
         dim, DataComponentInterpretation::component_is_part_of_vector);
       data_out.add_data_vector(u_ghost, std::vector<std::string>(dim, "displacement"),
                                DataOut<dim>::type_dof_data, vector);
-      if (analysis != Analysis::quasi_static)
-        data_out.add_data_vector(v_ghost, std::vector<std::string>(dim, "velocity"),
-                                 DataOut<dim>::type_dof_data, vector);
+      data_out.add_data_vector(v_ghost, std::vector<std::string>(dim, "velocity"),
+                               DataOut<dim>::type_dof_data, vector);
       const auto columns = PointData::columns<dim>(state_names);
       for (unsigned int k = 0; k < n_sym; ++k)
         {
@@ -317,8 +314,7 @@ namespace hysteron
             const CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
             fv.reinit(cell);
             fv[displacement].get_function_values(u_ghost, uq);
-            if (analysis != Analysis::quasi_static)
-              fv[displacement].get_function_values(v_ghost, vq);
+            fv[displacement].get_function_values(v_ghost, vq);
             for (unsigned int q = 0; q < n_q; ++q)
               {
                 // Sort key (reference position), then body and the point columns.
