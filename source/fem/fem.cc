@@ -986,11 +986,11 @@ namespace hysteron
         }
       else if (nominal == 0)
         nominal = time.end_time / n_increments;
-      unsigned int level = 0, successes = 0;
+      IncrementControl increments(nominal, newton.max_cuts);
 
       while (t < time.end_time - eps)
         {
-          double dt = std::min(nominal / std::pow(2.0, level), time.end_time - t);
+          const double dt = increments.step(t, time.end_time);
           if (analysis == Analysis::explicit_dynamics)
             {
               dealii::TimerOutput::Scope timing(scene.timer(), "steps");
@@ -1005,15 +1005,13 @@ namespace hysteron
               }
               if (!converged)
                 {
-                  ++n_cuts;
-                  successes = 0;
-                  if (++level > newton.max_cuts)
+                  if (!increments.cut())
                     {
                       std::ostringstream m;
                       m << "fem: Newton did not converge in the increment from t = " << t
                         << " s to " << t + dt << " s after " << newton.max_cuts
-                        << " cuts (increment " << dt << " s = " << nominal << " s / 2^" << newton.max_cuts
-                        << ")";
+                        << " cuts (increment " << dt << " s = " << nominal << " s / 2^"
+                        << newton.max_cuts << ")";
                       m << ": the structure may have reached its limit load (use displacement "
                            "control), or the increments or the tangent are poor (newton.csv has "
                            "the residuals)";
@@ -1025,16 +1023,9 @@ namespace hysteron
                   continue;
                 }
               commit(t + dt, dt);
-              if (level > 0 && ++successes >= 2)
-                {
-                  --level;
-                  successes = 0;
-                }
             }
-          t += dt;
-          // Times on the nominal grid stay exact (no drift of the sum of steps).
-          if (const double k = std::round(t / nominal); std::abs(t - k * nominal) < 1e-9 * nominal)
-            t = k * nominal;
+          increments.accept(t, dt);
+          n_cuts = increments.cuts();
           ++n_steps;
           const bool last = !(t < time.end_time - eps);
           if (rows.due(t, last))

@@ -5,6 +5,9 @@
 
 #include <hysteron/base/parameters.h>
 
+#include <algorithm>
+#include <cmath>
+
 namespace hysteron
 {
   /// `subsection Newton` of an implicit method (FEM, RBSN).
@@ -78,6 +81,68 @@ namespace hysteron
   newton_iterate(NewtonProblem          &problem,
                  const NewtonParameters &parameters,
                  const double            relative_floor);
+
+  /**
+   * The increments of an implicit run: the nominal step, halved after each
+   * failed increment (at most `Maximum increment cuts` times in a row), doubled
+   * back after two good ones. Times that land on the nominal grid are snapped
+   * to it (no drift of the sum of the steps).
+   */
+  class IncrementControl
+  {
+  public:
+    IncrementControl(const double nominal, const unsigned int max_cuts)
+      : nominal_step(nominal)
+      , max_cuts(max_cuts)
+    {}
+
+    /// The step from @p t, not beyond @p end.
+    double
+    step(const double t, const double end) const
+    {
+      return std::min(nominal_step / std::pow(2.0, level), end - t);
+    }
+
+    /// After a failed increment: halve; false when the cuts are used up.
+    bool
+    cut()
+    {
+      ++n_cuts;
+      successes = 0;
+      return ++level <= max_cuts;
+    }
+
+    /// After a converged increment of length @p dt: advance @p t.
+    void
+    accept(double &t, const double dt)
+    {
+      t += dt;
+      if (const double k = std::round(t / nominal_step); std::abs(t - k * nominal_step) < 1e-9 * nominal_step)
+        t = k * nominal_step;
+      if (level > 0 && ++successes >= 2)
+        {
+          --level;
+          successes = 0;
+        }
+    }
+
+    double
+    nominal() const
+    {
+      return nominal_step;
+    }
+
+    unsigned int
+    cuts() const
+    {
+      return n_cuts;
+    }
+
+  private:
+    double       nominal_step;
+    unsigned int max_cuts;
+    unsigned int level = 0, successes = 0, n_cuts = 0;
+  };
 } // namespace hysteron
 
 #endif
