@@ -856,6 +856,9 @@ namespace hysteron
       ghost = u;
       if (!assemble(ghost, t1, dt, Assemble::residual_and_matrix, false))
         return false;
+      // The out-of-balance force of the prescribed increments: the force level of a
+      // step that moves the body without loading it (a rigid motion).
+      predictor_level = system_rhs.l2_norm();
       n_linear += solve_linear(du);
       constraints.distribute(du);
       make_constraints(t1, false);

@@ -551,8 +551,8 @@ namespace hysteron
               double d2 = infinity;
               for (unsigned int i = 0, j = n - 1; i < n; j = i++)
                 d2 = std::min(d2, distance_squared(v[j], v[i], px, py));
-              if (inside) // t < 0: at least -t from the boundary
-                return d2 >= t * t;
+              if (inside) // inflated (t > 0): inside; deflated (t < 0): at least -t from the boundary
+                return t > 0 || d2 >= t * t;
               return d2 <= t * t; // t >= 0: on the boundary or within t of it
             }
           case Kind::all:

@@ -138,6 +138,17 @@ TEST(GeometryRegion, ConcavePolygon)
   EXPECT_TRUE(r.contains(Point<2>(1.0, 1.0)));
   EXPECT_FALSE(r.contains(Point<2>(1.5, 1.0 + 1e-10)));
   EXPECT_TRUE(r.contains(Point<2>(1.5, 1.0 + 1e-10), 1e-9));
+  // An inflated polygon contains its interior, its boundary and its vertices.
+  for (const double t : {1e-12, 1e-9, 1e-3})
+    {
+      EXPECT_TRUE(r.contains(Point<2>(0.5, 0.5), t));
+      EXPECT_TRUE(r.contains(Point<2>(0.0, 1.0), t));
+      EXPECT_TRUE(r.contains(Point<2>(0.0, 2.0), t));
+      EXPECT_TRUE(r.contains(Point<2>(1.0, 1.0), t));
+    }
+  // A deflated one keeps only the points at least |t| inside.
+  EXPECT_TRUE(r.contains(Point<2>(0.5, 0.5), -1e-3));
+  EXPECT_FALSE(r.contains(Point<2>(0.0, 1.0), -1e-3));
   EXPECT_DOUBLE_EQ(r.volume_estimate(), 3.0);
   const auto box = r.bounding_box().get_boundary_points();
   EXPECT_EQ(box.first, Point<2>(0, 0));

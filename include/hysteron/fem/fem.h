@@ -241,7 +241,7 @@ namespace hysteron
       double
       force_level() const
       {
-        return std::max(last_force_level, 1e-3 * force_scale);
+        return std::max({last_force_level, 1e-3 * force_scale, predictor_level});
       }
 
       /// The round-off floor 64 eps sqrt(N) of a residual of N entries, relative to
@@ -352,6 +352,7 @@ namespace hysteron
       double                   u_scale = 0;    ///< characteristic length for tolerances [m]
       double                   force_scale = 0; ///< largest force norm seen (Newton floor)
       double                   last_force_level = 0;
+      double                   predictor_level  = 0; ///< |residual| of the step's predictor
       double                   current_dt = 0;  ///< the step being solved
 
       // Diagnostics and bookkeeping.
