@@ -1,0 +1,215 @@
+#ifndef hysteron_rbsn_model_h
+#define hysteron_rbsn_model_h
+
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/sparse_direct.h>
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/vector.h>
+
+#include <hysteron/base/newton.h>
+#include <hysteron/base/output.h>
+#include <hysteron/material/bouc_wen_uniaxial.h>
+#include <hysteron/rbsn/tessellation.h>
+#include <hysteron/scene/method.h>
+#include <hysteron/scene/scene.h>
+#include <hysteron/scene/tables.h>
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace hysteron
+{
+  namespace RBSN
+  {
+    enum class Analysis
+    {
+      linear_static,     ///< elastic springs, one solve per step
+      quasi_static,      ///< Bouc-Wen springs, load stepping with Newton
+      implicit_dynamics, ///< Newmark / HHT-alpha with Newton
+      variable_order     ///< SUNDIALS IDA (variable-order BDF) on u, v and the spring states
+    };
+
+    /// Brittle fracture of the facets (eq. 3.49-3.51).
+    struct FractureParameters
+    {
+      bool   enabled          = false;
+      double tensile_strength = 0; ///< f_t [Pa]: the tension cut-off of the normal stress
+      double cohesion         = 0; ///< c [Pa]: the shear strength at zero normal stress
+      double friction         = 0; ///< tan of the friction angle
+      unsigned int max_cycles = 1000; ///< breaks within one step before the run stops
+    };
+
+    /**
+     * One facet's three springs (normal, tangential, rotational): stiffness,
+     * yield value, the uniaxial Bouc-Wen laws and their converged and trial
+     * state. Deformations delta = (delta_n, delta_t, phi) = B [u_a; u_b].
+     */
+    struct Springs
+    {
+      std::array<double, 3>                   k{}, yield{};
+      std::array<Material::BoucWenUniaxial, 3> law;
+      std::array<double, 3> delta{}, force{}, trial_delta{}, trial_force{}, tangent{};
+      std::array<double, 3 * Material::BoucWenUniaxial::max_n_state_variables> state{}, trial_state{};
+      std::array<double, 6> B_n{}, B_t{}; ///< the rows n and t of B (the third is (0, 0, -1, 0, 0, 1))
+      double                thickness  = 1;
+      bool                  hysteretic = false; ///< Bouc-Wen laws (else linear springs)
+      bool                  broken     = false;
+    };
+
+    /// The scene on the network (see Solver). Two-dimensional.
+    class Model
+    {
+    public:
+      Model(const Scene<2> &scene, const Methods::Interface<2> &method, dealii::ParameterHandler &prm);
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+
+      void
+      run();
+
+      std::string
+      summary() const;
+
+      const Tessellation &
+      tessellation() const
+      {
+        return network;
+      }
+
+    private:
+      using Vector = dealii::Vector<double>;
+
+      /// A kinematic condition on cell DoFs (a scene boundary or a rigid body).
+      struct Dirichlet
+      {
+        std::string               name;
+        int                       boundary = -1, rigid = -1;
+        std::vector<unsigned int> dofs; ///< 3 cell + component (2 = rotation)
+      };
+
+      /// A load on cells: a force and moment per cell, times the load's value.
+      struct LoadSet
+      {
+        unsigned int                        load = 0;
+        std::vector<unsigned int>           cells;
+        std::vector<dealii::Tensor<1, 2>>   arm;    ///< moment arm of each contribution (traction)
+        std::vector<double>                 weight; ///< force = weight value(t)
+      };
+
+      // Set-up.
+      void
+      build_network();
+      void
+      setup_springs();
+      void
+      setup_system();
+      void
+      setup_conditions();
+
+      // Steps.
+      void
+      make_constraints(const double t0, const double t1, const bool predictor);
+      bool
+      assemble(const double t1, const double dt, const bool matrix, const bool update_springs);
+      bool
+      solve_step(const double t, const double dt);
+      void
+      commit(const double t1, const double dt);
+      void
+      solve_linear(Vector &x);
+      /// The facet whose fracture ratio R is largest if above 1, else -1.
+      int
+      facet_to_break() const;
+      void
+      external_forces(const double t, Vector &f) const;
+      /// Initial velocities and accelerations (implicit dynamics).
+      void
+      initial_state();
+      /// Newton's force level: the last evaluation's, at least 1e-3 of the largest so far.
+      double
+      force_level() const
+      {
+        return std::max({last_force_level, 1e-3 * force_scale, predictor_level});
+      }
+      void
+      record_break(const unsigned int facet, const double t);
+      void
+      open_tables();
+      void
+      commit_tables();
+      void
+      write_spring_table() const;
+      /// The probe / average values of cell @p c and facet @p e (-1: none) into @p out.
+      void
+      point_values(const unsigned int c, const int e, const dealii::Point<2> &x, double *out) const;
+      [[noreturn]] void
+      fail(const std::string &what, const double t);
+
+      // Output.
+      std::vector<std::string>
+      point_columns() const;
+      void
+      write_table_rows(const double t);
+      void
+      write_fields(const double t);
+      void
+      write_vtu(std::ostream &out) const;
+
+      const Scene<2>              &scene;
+      const Methods::Interface<2> &method;
+
+      // Parameters.
+      double                        d_m = 0;
+      bool                          points_on_boundary = true;
+      std::vector<dealii::Point<2>> extra_points;
+      double                        boundary_h   = 0;
+      double                        shear_ratio  = 0;
+      double                        moment_yield = 0.25;
+      Analysis                      analysis     = Analysis::quasi_static;
+      double                        time_step    = 0;
+      unsigned int                  n_increments = 100;
+      NewtonParameters              newton;
+      double                        hht_alpha = 0, rayleigh_mass = 0, rayleigh_stiffness = 0;
+      FractureParameters            fracture;
+      bool                          spring_table = false;
+
+      // The network: cells (rigid bodies), facets (springs), bodies.
+      Tessellation                          network;
+      std::vector<unsigned int>             cell_body;
+      std::vector<double>                   cell_mass, cell_inertia; ///< about the nucleus
+      std::vector<dealii::Tensor<1, 2>>     cell_offset;            ///< centroid - nucleus
+      std::vector<Springs>                  springs;
+      std::vector<const Geometry::Region<2> *> body_shapes;
+      std::vector<unsigned int>             mesh_body; ///< shape index -> scene body
+      double                                scale = 1;
+      bool                                  consistent_tangent = true;
+
+      // Linear algebra: 3 DoFs (u, v, theta) per cell.
+      dealii::SparsityPattern           pattern;
+      dealii::SparseMatrix<double>      matrix;
+      dealii::SparseDirectUMFPACK       direct;
+      dealii::AffineConstraints<double> constraints;
+      Vector u, u_trial, v, a, rhs, f_int, f_ext, f_ext_old, inertia, reaction_old;
+      std::vector<Dirichlet> dirichlet;
+      std::vector<int>       dof_set; ///< the Dirichlet set of each DoF, -1 if free
+      std::vector<LoadSet>   load_sets;
+      double                 force_scale = 0, last_force_level = 0, predictor_level = 0;
+
+      // Bookkeeping.
+      PointData::Tables<2>                 tables;
+      std::unique_ptr<Output::CsvWriter>   newton_table, fracture_table;
+      std::unique_ptr<Output::FieldWriter> field_writer;
+      double internal_work = 0, external_work = 0, boundary_work = 0;
+      unsigned long n_steps = 0, n_newton = 0, n_broken = 0;
+      unsigned int  n_outputs = 0, n_cuts = 0;
+      std::string   spring_failure;
+      std::vector<int>              probe_cell, probe_facet;
+    };
+  } // namespace RBSN
+} // namespace hysteron
+
+#endif

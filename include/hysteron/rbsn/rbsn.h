@@ -1,0 +1,55 @@
+#ifndef hysteron_rbsn_rbsn_h
+#define hysteron_rbsn_rbsn_h
+
+#include <hysteron/scene/method.h>
+
+#include <memory>
+#include <string>
+
+namespace hysteron
+{
+  namespace RBSN
+  {
+    class Model;
+
+    /**
+     * The Rigid-Body-Spring Network (`set Method = rbsn`, dissertation chapter
+     * 3; doc/rbsn.md): the scene's bodies (2D) are cut into Voronoi cells around
+     * seeded random points; every cell is a rigid body with the DoFs u, v, theta
+     * of its nucleus, and every common facet of two cells carries three
+     * zero-length springs (normal, tangential, rotational) with the Voronoi
+     * scaled stiffnesses of eq. 3.9 and uniaxial Bouc-Wen laws (eq. 3.32-3.36).
+     * Static, quasi-static (Newton) and dynamic (Newmark / HHT with Newton, or
+     * SUNDIALS' variable-order IDA) analyses, and brittle fracture of the facets
+     * (Mohr-Coulomb with a tension cut-off, eq. 3.49-3.51).
+     *
+     * The work is done by Model (two-dimensional); in a 3D scene the method is
+     * refused.
+     */
+    template <int dim>
+    class Solver : public Methods::Interface<dim>
+    {
+    public:
+      Solver();
+      ~Solver() override;
+
+      static void
+      declare_parameters(dealii::ParameterHandler &prm);
+
+      void
+      run() override;
+
+      std::string
+      summary() const override;
+
+    protected:
+      void
+      parse_parameters(dealii::ParameterHandler &prm) override;
+
+    private:
+      std::unique_ptr<Model> model;
+    };
+  } // namespace RBSN
+} // namespace hysteron
+
+#endif

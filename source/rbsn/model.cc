@@ -1,0 +1,662 @@
+#include <deal.II/base/utilities.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+
+#include <hysteron/base/parameters.h>
+#include <hysteron/base/progress.h>
+#include <hysteron/material/bouc_wen.h>
+#include <hysteron/rbsn/model.h>
+#include <hysteron/rbsn/rbsn.h>
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace hysteron
+{
+  namespace RBSN
+  {
+    namespace
+    {
+      std::vector<dealii::Point<2>>
+      parse_point_list(const std::string &text, const std::string &where)
+      {
+        std::vector<dealii::Point<2>> points;
+        for (const auto &item : dealii::Utilities::split_string_list(text, ';'))
+          {
+            if (item.empty())
+              continue;
+            const auto c = dealii::Utilities::split_string_list(item, ',');
+            require(c.size() == 2, where, "the point '" + item + "' needs 2 coordinates");
+            try
+              {
+                points.emplace_back(dealii::Utilities::string_to_double(c[0]),
+                                    dealii::Utilities::string_to_double(c[1]));
+              }
+            catch (...)
+              {
+                throw InputError(where, "cannot read the point '" + item + "'");
+              }
+          }
+        return points;
+      }
+    } // namespace
+
+
+
+    void
+    Model::declare_parameters(dealii::ParameterHandler &prm)
+    {
+      using namespace dealii;
+      prm.enter_subsection("RBSN");
+      {
+        prm.declare_entry("Minimum distance",
+                          "0.05",
+                          Patterns::Double(),
+                          "d_m [m] > 0: random nuclei keep at least this distance from each other "
+                          "(Poisson-disk sampling up to saturation, about 0.68 A / d_m^2 points in "
+                          "an area A; dissertation §3.3.3).");
+        prm.declare_entry("Points on the boundary",
+                          "true",
+                          Patterns::Bool(),
+                          "Place nuclei along the bodies' boundaries (corners kept, spacing about "
+                          "d_m), so that boundary cells have their computational point on the "
+                          "boundary, where supports and loads act.");
+        prm.declare_entry("Additional points",
+                          "",
+                          Patterns::Anything(),
+                          "Nuclei placed by the user [m], 'x, y; x, y; ...' (supports, load "
+                          "points); the random points keep d_m from them.");
+        prm.declare_entry("Curved boundary resolution",
+                          "0",
+                          Patterns::Double(),
+                          "Segment length [m] of curved boundaries (disks as polygons), >= 0; 0: "
+                          "d_m / 4.");
+        prm.declare_entry("Shear stiffness ratio",
+                          "0",
+                          Patterns::Double(),
+                          "k_t / k_n, >= 0; 0: from the material, k_t = G t l / h and k_n = "
+                          "E' t l / h (eq. 3.9; E' = E / (1 - nu^2) in plane stress). 1 makes the "
+                          "network elastically uniform under any uniform strain (with nu = 0).");
+        prm.declare_entry("Moment yield factor",
+                          "0.25",
+                          Patterns::Double(),
+                          "The rotational spring yields at M_y = factor sigma_y t l^2 (0.25: the "
+                          "plastic moment of the facet's section), > 0. The normal and tangential "
+                          "springs yield at sigma_y t l and sigma_y t l / sqrt(3).");
+        prm.declare_entry("Analysis",
+                          "quasi-static",
+                          Patterns::Selection("static|quasi-static|implicit dynamics"),
+                          "static: elastic springs (the material's plasticity ignored), one "
+                          "linear solve per step; quasi-static: Bouc-Wen springs, load stepping "
+                          "with Newton; implicit dynamics: Newmark / HHT-alpha with Newton (mass "
+                          "matrix eq. 3.12, Rayleigh damping).");
+        prm.declare_entry("Time step",
+                          "0",
+                          Patterns::Double(),
+                          "Step [s], >= 0; 0: Time/Time step if > 0, else End time / Number of "
+                          "increments. Newton failures halve it.");
+        prm.declare_entry("Number of increments", "100", Patterns::Integer(1), "See Time step.");
+        prm.declare_entry("Write spring table",
+                          "false",
+                          Patterns::Bool(),
+                          "Write springs.csv at the end: every facet (cells, midpoint, length, "
+                          "distance, stiffnesses, forces, H1 of the three springs, broken).");
+        prm.enter_subsection("Newton");
+        NewtonParameters::declare_parameters(prm);
+        prm.leave_subsection();
+        prm.enter_subsection("Dynamics");
+        {
+          prm.declare_entry("HHT alpha", "0", Patterns::Double(), "In [-1/3, 0]; 0: Newmark average acceleration.");
+          prm.declare_entry("Rayleigh mass coefficient", "0", Patterns::Double(), "a0 [1/s] of C = a0 M + a1 K0, >= 0.");
+          prm.declare_entry("Rayleigh stiffness coefficient", "0", Patterns::Double(), "a1 [s], >= 0 (K0: the elastic stiffness).");
+        }
+        prm.leave_subsection();
+        prm.enter_subsection("Fracture");
+        {
+          prm.declare_entry("Enabled", "false", Patterns::Bool(), "Brittle fracture of the facets (eq. 3.49-3.51).");
+          prm.declare_entry("Tensile strength",
+                            "0",
+                            Patterns::Double(),
+                            "f_t [Pa] > 0: a facet breaks when its normal stress s_n = F_n / (t l) "
+                            "exceeds it (tension cut-off).");
+          prm.declare_entry("Cohesion",
+                            "0",
+                            Patterns::Double(),
+                            "c [Pa] > 0: ... or when |s_t| + tan(phi) s_n > c (Mohr-Coulomb; "
+                            "s_t = F_t / (t l), tension positive).");
+          prm.declare_entry("Friction angle", "0", Patterns::Double(), "phi [degrees] in [0, 90).");
+          prm.declare_entry("Maximum breaks per step",
+                            "1000",
+                            Patterns::Integer(1),
+                            "A step is solved again after every break (one facet, the one with the "
+                            "largest R = max(s_n / f_t, (|s_t| + tan(phi) s_n) / c)); more breaks "
+                            "than this in one step stop the run.");
+        }
+        prm.leave_subsection();
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    Model::Model(const Scene<2> &scene, const Methods::Interface<2> &method, dealii::ParameterHandler &prm)
+      : scene(scene)
+      , method(method)
+    {
+      {
+        Section s(prm, {"RBSN"});
+        d_m                = s.get_positive("Minimum distance");
+        points_on_boundary = s.get_bool("Points on the boundary");
+        extra_points       = parse_point_list(s.get("Additional points"), s.where("Additional points"));
+        boundary_h         = s.get_non_negative("Curved boundary resolution");
+        if (boundary_h == 0)
+          boundary_h = 0.25 * d_m;
+        shear_ratio  = s.get_non_negative("Shear stiffness ratio");
+        moment_yield = s.get_positive("Moment yield factor");
+        const std::string type = s.get("Analysis");
+        analysis = type == "static" ? Analysis::linear_static :
+                   type == "quasi-static" ? Analysis::quasi_static :
+                                            Analysis::implicit_dynamics;
+        time_step    = s.get_non_negative("Time step");
+        n_increments = s.get_integer("Number of increments");
+        spring_table = s.get_bool("Write spring table");
+      }
+      newton.parse_parameters(Section(prm, {"RBSN", "Newton"}));
+      {
+        Section s(prm, {"RBSN", "Dynamics"});
+        hht_alpha = s.get_double("HHT alpha");
+        require(hht_alpha >= -1.0 / 3.0 - 1e-14 && hht_alpha <= 0,
+                s.where("HHT alpha"),
+                "must be in [-1/3, 0] (got " + s.get("HHT alpha") + ")");
+        rayleigh_mass      = s.get_non_negative("Rayleigh mass coefficient");
+        rayleigh_stiffness = s.get_non_negative("Rayleigh stiffness coefficient");
+      }
+      {
+        Section s(prm, {"RBSN", "Fracture"});
+        fracture.enabled = s.get_bool("Enabled");
+        if (fracture.enabled)
+          {
+            fracture.tensile_strength = s.get_positive("Tensile strength");
+            fracture.cohesion         = s.get_positive("Cohesion");
+            const double phi          = s.get_non_negative("Friction angle");
+            require(phi < 90, s.where("Friction angle"), "must be below 90 degrees");
+            fracture.friction   = std::tan(phi * M_PI / 180);
+            fracture.max_cycles = s.get_integer("Maximum breaks per step");
+          }
+      }
+
+      const auto &bodies = scene.body_descriptions();
+      require(!bodies.empty(), "Body names", "the rbsn method needs at least one body");
+      for (unsigned int b = 0; b < bodies.size(); ++b)
+        if (!bodies[b].rigid)
+          {
+            body_shapes.push_back(&bodies[b].shape);
+            mesh_body.push_back(b);
+            const auto &m = scene.material(bodies[b].material, "Body " + bodies[b].name + "/Material");
+            require(m.elasticity().stress_state != Material::StressState::three_dimensional,
+                    "Body " + bodies[b].name + "/Material",
+                    "the rbsn method is two-dimensional");
+            const bool bouc_wen = dynamic_cast<const Material::BoucWen<2> *>(&m) != nullptr;
+            require(bouc_wen || m.n_state_variables() == 0,
+                    "Body " + bodies[b].name + "/Material",
+                    "the rbsn method's springs follow the uniaxial Bouc-Wen law: the body's "
+                    "material must be 'bouc-wen' or 'linear elastic'");
+            consistent_tangent = consistent_tangent && m.has_consistent_tangent();
+            require(bodies[b].initial_velocity == nullptr || analysis == Analysis::implicit_dynamics,
+                    "Body " + bodies[b].name + "/Initial velocity",
+                    "only dynamic analyses have velocities");
+          }
+      require(!body_shapes.empty(), "Body names", "the rbsn method needs a body that is not rigid");
+      for (const auto &b : scene.boundary_descriptions())
+        require(b.type != BoundaryDescription<2>::Type::wall,
+                "Boundary " + b.name + "/Type",
+                "the rbsn method has no walls (use fixed, roller, velocity or displacement)");
+    }
+
+
+
+    void
+    Model::build_network()
+    {
+      const auto &bodies = scene.body_descriptions();
+      // The nuclei: the user's points, points along every body's boundary, then
+      // random points (one set for all bodies; each point belongs to the body
+      // that contains it).
+      std::vector<dealii::Point<2>> fixed = extra_points;
+      if (points_on_boundary)
+        for (const auto *shape : body_shapes)
+          {
+            const auto p = boundary_points(*shape, d_m, boundary_h);
+            fixed.insert(fixed.end(), p.begin(), p.end());
+          }
+      // Merge points closer than 1e-6 d_m (corners shared by touching bodies).
+      std::vector<dealii::Point<2>> unique;
+      for (const auto &p : fixed)
+        {
+          bool seen = false;
+          for (const auto &q : unique)
+            seen = seen || p.distance(q) < 1e-6 * d_m;
+          if (!seen)
+            unique.push_back(p);
+        }
+      std::vector<dealii::Point<2>> points = unique;
+      for (unsigned int s = 0; s < body_shapes.size(); ++s)
+        {
+          // Each body is filled in turn, keeping d_m from every point so far.
+          auto filled = poisson_disk_points(*body_shapes[s], d_m, points,
+                                            scene.random_seed() + 7919 * s, "RBSN/Minimum distance");
+          points.swap(filled);
+        }
+      network = voronoi(points, body_shapes, boundary_h, "Body names");
+
+      // The bodies and the rigid-body mass properties about the nuclei (eq. 3.12).
+      const unsigned int n = network.cells.size();
+      cell_body.assign(n, 0);
+      cell_mass.assign(n, 0);
+      cell_inertia.assign(n, 0);
+      cell_offset.assign(n, dealii::Tensor<1, 2>());
+      const auto lo = bodies[mesh_body[0]].shape.bounding_box().get_boundary_points();
+      scale         = lo.first.distance(lo.second);
+      for (unsigned int c = 0; c < n; ++c)
+        {
+          const auto &cell = network.cells[c];
+          for (unsigned int s = 0; s < body_shapes.size(); ++s)
+            if (body_shapes[s]->contains(cell.nucleus, 1e-9 * scale))
+              {
+                cell_body[c] = mesh_body[s];
+                break;
+              }
+          const auto  &body = bodies[cell_body[c]];
+          const double rho  = scene.material(body.material, "Body " + body.name + "/Material").density();
+          const double m    = rho * body.thickness * cell.area;
+          cell_mass[c]      = m;
+          cell_offset[c]    = cell.centroid - cell.nucleus;
+          // I_c + m r^2: the polar moment about the nucleus.
+          cell_inertia[c] = rho * body.thickness * cell.polar_moment + m * cell_offset[c].norm_square();
+        }
+    }
+
+
+
+    void
+    Model::setup_springs()
+    {
+      const auto &bodies = scene.body_descriptions();
+      springs.assign(network.facets.size(), Springs());
+      for (unsigned int e = 0; e < network.facets.size(); ++e)
+        {
+          const Facet &f  = network.facets[e];
+          Springs     &sp = springs[e];
+          const auto  &ba = bodies[cell_body[f.a]], &bb = bodies[cell_body[f.b]];
+          const auto  &ma = scene.material(ba.material, "Body " + ba.name + "/Material");
+          const auto  &mb = scene.material(bb.material, "Body " + bb.name + "/Material");
+          const double t  = std::min(ba.thickness, bb.thickness);
+          const double l  = f.length;
+          // Voronoi scaling (eq. 3.9), the two half-cells in series:
+          // k_n = t l / (h_a / E'_a + h_b / E'_b), k_t likewise with G, k_phi = k_n l^2 / 12.
+          sp.k[0] = t * l / (f.h_a / ma.elasticity().p_wave_modulus() + f.h_b / mb.elasticity().p_wave_modulus());
+          sp.k[1] = shear_ratio > 0 ? shear_ratio * sp.k[0] :
+                                      t * l / (f.h_a / ma.elasticity().shear_modulus() +
+                                               f.h_b / mb.elasticity().shear_modulus());
+          sp.k[2]      = sp.k[0] * l * l / 12;
+          sp.thickness = t;
+          // B (eq. 3.6, with the errata of DESIGN.md §3): the displacement of P as a
+          // point of cell b minus as a point of cell a, in the facet's (n, t) axes,
+          // u_P = u_i - (y_P - y_i) theta_i, v_P = v_i + (x_P - x_i) theta_i.
+          const dealii::Tensor<1, 2> n = f.normal, tt({-n[1], n[0]});
+          const dealii::Tensor<1, 2> ra = f.midpoint - network.cells[f.a].nucleus;
+          const dealii::Tensor<1, 2> rb = f.midpoint - network.cells[f.b].nucleus;
+          const auto cross = [](const dealii::Tensor<1, 2> &r, const dealii::Tensor<1, 2> &w) {
+            return r[0] * w[1] - r[1] * w[0];
+          };
+          sp.B_n = {{-n[0], -n[1], -cross(ra, n), n[0], n[1], cross(rb, n)}};
+          sp.B_t = {{-tt[0], -tt[1], -cross(ra, tt), tt[0], tt[1], cross(rb, tt)}};
+
+          // Bouc-Wen springs (uniaxial, eq. 3.32-3.36) when both cells are Bouc-Wen.
+          const auto *bwa = dynamic_cast<const Material::BoucWen<2> *>(&ma);
+          const auto *bwb = dynamic_cast<const Material::BoucWen<2> *>(&mb);
+          if (bwa && bwb && analysis != Analysis::linear_static)
+            {
+              const auto  &prm     = bwa->get_parameters();
+              const double sigma_y = std::min(prm.yield_stress, bwb->get_parameters().yield_stress);
+              sp.yield             = {{sigma_y * t * l, sigma_y * t * l / std::sqrt(3.0), moment_yield * sigma_y * t * l * l}};
+              for (unsigned int i = 0; i < 3; ++i)
+                {
+                  sp.law[i].reinit(prm, sp.k[i], sp.yield[i]);
+                  sp.law[i].initialize_state(sp.state.data() + 3 * i);
+                }
+              sp.hysteretic = true;
+            }
+          sp.tangent     = sp.k; // the first predictor's
+          sp.trial_state = sp.state;
+        }
+    }
+
+
+
+    void
+    Model::setup_system()
+    {
+      const unsigned int            n = 3 * network.cells.size();
+      dealii::DynamicSparsityPattern dsp(n, n);
+      for (unsigned int c = 0; c < network.cells.size(); ++c)
+        for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int j = 0; j < 3; ++j)
+            dsp.add(3 * c + i, 3 * c + j);
+      for (const auto &f : network.facets)
+        for (const unsigned int p : {f.a, f.b})
+          for (const unsigned int q : {f.a, f.b})
+            for (unsigned int i = 0; i < 3; ++i)
+              for (unsigned int j = 0; j < 3; ++j)
+                dsp.add(3 * p + i, 3 * q + j);
+      pattern.copy_from(dsp);
+      matrix.reinit(pattern);
+      for (Vector *w : {&u, &u_trial, &v, &a, &rhs, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
+        w->reinit(n);
+    }
+
+
+
+    void
+    Model::setup_conditions()
+    {
+      using Type         = BoundaryDescription<2>::Type;
+      const auto &bodies = scene.body_descriptions();
+      const auto  box    = [&] {
+        dealii::Point<2> lo(1e300, 1e300), hi(-1e300, -1e300);
+        for (const auto &c : network.cells)
+          for (unsigned int d = 0; d < 2; ++d)
+            {
+              lo[d] = std::min(lo[d], c.nucleus[d]);
+              hi[d] = std::max(hi[d], c.nucleus[d]);
+            }
+        return std::make_pair(lo, hi);
+      }();
+      const double tolerance = 1e-9 * scale;
+      dof_set.assign(3 * network.cells.size(), -1);
+      dirichlet.clear();
+      const auto take = [&](Dirichlet &set, const unsigned int dof) {
+        if (dof_set[dof] < 0)
+          {
+            dof_set[dof] = dirichlet.size();
+            set.dofs.push_back(dof);
+          }
+      };
+      // velocity / displacement: the selected components; with both, also the rotation
+      // (the rigid motion of the cell that the field gives its nucleus).
+      const auto take_prescribed = [&](Dirichlet &set, const unsigned int c, const BoundaryDescription<2> &d) {
+        for (unsigned int k = 0; k < 2; ++k)
+          if (d.components[k])
+            take(set, 3 * c + k);
+        if (d.components[0] && d.components[1])
+          take(set, 3 * c + 2);
+      };
+      for (unsigned int b = 0; b < scene.boundary_descriptions().size(); ++b)
+        {
+          const auto &d = scene.boundary_descriptions()[b];
+          Dirichlet   set;
+          set.name     = d.name;
+          set.boundary = b;
+          for (unsigned int c = 0; c < network.cells.size(); ++c)
+            {
+              const auto &x = network.cells[c].nucleus;
+              for (const unsigned int face : d.faces)
+                {
+                  const unsigned int dir = face / 2;
+                  const double       at  = face % 2 == 0 ? box.first[dir] : box.second[dir];
+                  if (std::abs(x[dir] - at) <= tolerance)
+                    {
+                      if (d.type == Type::fixed)
+                        for (unsigned int k = 0; k < 3; ++k)
+                          take(set, 3 * c + k);
+                      else if (d.type == Type::roller)
+                        take(set, 3 * c + dir);
+                      else
+                        take_prescribed(set, c, d);
+                    }
+                }
+              if (d.has_region && d.region.contains(x, tolerance))
+                {
+                  if (d.type == Type::fixed)
+                    for (unsigned int k = 0; k < 3; ++k)
+                      take(set, 3 * c + k);
+                  else
+                    take_prescribed(set, c, d);
+                }
+            }
+          require(!set.dofs.empty(),
+                  "Boundary " + d.name + (d.has_region ? "/Region" : "/Faces"),
+                  "selects no cell of the network (a cell is selected by its nucleus: on the face "
+                  "of the nuclei's bounding box, or in the region)");
+          dirichlet.push_back(std::move(set));
+        }
+      for (unsigned int b = 0; b < bodies.size(); ++b)
+        if (bodies[b].rigid)
+          {
+            Dirichlet set;
+            set.name  = bodies[b].name;
+            set.rigid = b;
+            for (unsigned int c = 0; c < network.cells.size(); ++c)
+              if (bodies[b].shape.contains(network.cells[c].nucleus, tolerance))
+                for (unsigned int k = 0; k < 3; ++k)
+                  take(set, 3 * c + k);
+            require(!set.dofs.empty(),
+                    "Body " + bodies[b].name + "/Shape",
+                    "the rigid body holds no nucleus of the network (it moves the cells whose "
+                    "nuclei lie in its shape)");
+            dirichlet.push_back(std::move(set));
+          }
+
+      // Loads: a total force shared evenly by the cells whose nucleus is in the
+      // region; a traction on the boundary pieces of the cells in the region.
+      load_sets.clear();
+      const auto &loads = scene.load_descriptions();
+      for (unsigned int l = 0; l < loads.size(); ++l)
+        {
+          LoadSet set;
+          set.load = l;
+          if (loads[l].type == LoadDescription<2>::Type::force)
+            {
+              for (unsigned int c = 0; c < network.cells.size(); ++c)
+                if (loads[l].region.contains(network.cells[c].nucleus, tolerance))
+                  {
+                    set.cells.push_back(c);
+                    set.arm.emplace_back();
+                  }
+              for (unsigned int k = 0; k < set.cells.size(); ++k)
+                set.weight.push_back(1.0 / set.cells.size());
+            }
+          else
+            for (unsigned int c = 0; c < network.cells.size(); ++c)
+              for (const auto &piece : network.cells[c].boundary)
+                {
+                  const dealii::Point<2> mid = 0.5 * (piece[0] + piece[1]);
+                  if (!loads[l].region.contains(mid, tolerance))
+                    continue;
+                  set.cells.push_back(c);
+                  set.arm.push_back(mid - network.cells[c].nucleus);
+                  set.weight.push_back(piece[0].distance(piece[1]) * bodies[cell_body[c]].thickness);
+                }
+          require(!set.cells.empty(),
+                  "Load " + loads[l].name + "/Region",
+                  loads[l].type == LoadDescription<2>::Type::force ?
+                    "contains no nucleus of the network" :
+                    "contains no boundary piece of the network");
+          load_sets.push_back(std::move(set));
+        }
+    }
+
+
+
+    void
+    Model::make_constraints(const double t0, const double t1, const bool predictor)
+    {
+      const auto &bodies = scene.body_descriptions();
+      constraints.clear();
+      for (unsigned int s = 0; s < dirichlet.size(); ++s)
+        {
+          const auto &set = dirichlet[s];
+          for (const unsigned int dof : set.dofs)
+            {
+              constraints.add_line(dof);
+              if (!predictor)
+                continue;
+              const unsigned int c = dof / 3, k = dof % 3;
+              double             increment = 0;
+              if (set.rigid >= 0)
+                increment = k < 2 ? integrate_in_time<2>(*bodies[set.rigid].rigid_velocity, t0, t1)[k] : 0.0;
+              else
+                {
+                  const auto &d = scene.boundary_descriptions()[set.boundary];
+                  const auto &x = network.cells[c].nucleus;
+                  if (k < 2 && (d.velocity || d.displacement))
+                    increment = d.displacement_increment(t0, t1, x)[k];
+                  else if (k == 2 && d.displacement)
+                    {
+                      // The rotation 1/2 (du_y/dx - du_x/dy) of the field, by central differences.
+                      const double e = 1e-4 * scale;
+                      const auto   du = [&](const double dx, const double dy) {
+                        return d.displacement_increment(t0, t1, x + dealii::Tensor<1, 2>({dx, dy}));
+                      };
+                      increment = 0.25 / e * ((du(e, 0)[1] - du(-e, 0)[1]) - (du(0, e)[0] - du(0, -e)[0]));
+                    }
+                }
+              constraints.set_inhomogeneity(dof, increment);
+            }
+        }
+      constraints.close();
+    }
+
+
+
+    void
+    Model::external_forces(const double t, Vector &f) const
+    {
+      // Loads, and gravity at the centroids (a force and its moment about the nucleus).
+      f                      = 0;
+      const auto          &loads = scene.load_descriptions();
+      const auto           cross = [](const dealii::Tensor<1, 2> &r, const dealii::Tensor<1, 2> &w) {
+        return r[0] * w[1] - r[1] * w[0];
+      };
+      for (const auto &set : load_sets)
+        {
+          const dealii::Tensor<1, 2> value = loads[set.load].value_at(t);
+          for (unsigned int k = 0; k < set.cells.size(); ++k)
+            {
+              const dealii::Tensor<1, 2> F = set.weight[k] * value;
+              f(3 * set.cells[k]) += F[0];
+              f(3 * set.cells[k] + 1) += F[1];
+              f(3 * set.cells[k] + 2) += cross(set.arm[k], F);
+            }
+        }
+      const dealii::Tensor<1, 2> &g = scene.gravity();
+      if (g.norm() > 0)
+        for (unsigned int c = 0; c < network.cells.size(); ++c)
+          {
+            const dealii::Tensor<1, 2> F = cell_mass[c] * g;
+            f(3 * c) += F[0];
+            f(3 * c + 1) += F[1];
+            f(3 * c + 2) += cross(cell_offset[c], F);
+          }
+    }
+
+
+
+    void
+    Model::solve_linear(Vector &x)
+    {
+      try
+        {
+          direct.initialize(matrix);
+          direct.vmult(x, rhs);
+        }
+      catch (const dealii::ExceptionBase &)
+        {
+          throw RuntimeError("rbsn: the stiffness matrix is singular: a part of the network is "
+                             "not supported (fewer supports than rigid-body motions, or broken "
+                             "facets have cut it loose)");
+        }
+    }
+
+
+
+    void
+    Model::fail(const std::string &what, const double t)
+    {
+      write_fields(t);
+      write_table_rows(t);
+      tables.commit();
+      for (auto *table : {newton_table.get(), fracture_table.get()})
+        if (table)
+          table->commit();
+      std::ostringstream s;
+      s << std::setprecision(6) << t;
+      throw RuntimeError(what + " The last good state (t = " + s.str() + " s) was written.");
+    }
+
+
+
+    std::string
+    Model::summary() const
+    {
+      std::ostringstream s;
+      s << network.cells.size() << " cells, " << network.facets.size() << " facets, " << n_steps
+        << " steps, " << n_newton << " Newton iterations";
+      if (fracture.enabled)
+        s << ", " << n_broken << " broken facets";
+      s << ", " << n_outputs << " outputs";
+      return s.str();
+    }
+
+
+
+    template <int dim>
+    Solver<dim>::Solver() = default;
+
+    template <int dim>
+    Solver<dim>::~Solver() = default;
+
+    template <int dim>
+    void
+    Solver<dim>::declare_parameters(dealii::ParameterHandler &prm)
+    {
+      Model::declare_parameters(prm);
+    }
+
+    template <int dim>
+    void
+    Solver<dim>::parse_parameters(dealii::ParameterHandler &prm)
+    {
+      if constexpr (dim == 2)
+        model = std::make_unique<Model>(this->get_scene(), *this, prm);
+      else
+        {
+          (void)prm;
+          throw InputError("Dimension", "the rbsn method is two-dimensional (set Dimension = 2)");
+        }
+    }
+
+    template <int dim>
+    void
+    Solver<dim>::run()
+    {
+      model->run();
+    }
+
+    template <int dim>
+    std::string
+    Solver<dim>::summary() const
+    {
+      return model ? model->summary() : std::string();
+    }
+
+    template class Solver<2>;
+    template class Solver<3>;
+  } // namespace RBSN
+} // namespace hysteron
+
+HYSTERON_REGISTER_METHOD(hysteron::RBSN::Solver,
+                         "rbsn",
+                         "the Rigid-Body-Spring Network: Voronoi cells as rigid bodies joined by "
+                         "Bouc-Wen springs at their facets, static, quasi-static and dynamic, with "
+                         "brittle fracture; 2D; see doc/rbsn.md");

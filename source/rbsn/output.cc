@@ -1,0 +1,310 @@
+#include <hysteron/rbsn/model.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace hysteron
+{
+  namespace RBSN
+  {
+    std::vector<std::string>
+    Model::point_columns() const
+    {
+      return {"x_x", "x_y", "u_x", "u_y", "v_x", "v_y", "theta", "omega",
+              "f_n", "f_t", "m", "s_n", "s_t", "H1_n", "H1_t", "H1_m", "broken"};
+    }
+
+
+
+    void
+    Model::point_values(const unsigned int c, const int e, const dealii::Point<2> &p, double *out) const
+    {
+      // The rigid motion of cell c at p: u(p) = u_c + theta (-(y - y_c), x - x_c).
+      const dealii::Tensor<1, 2> r = p - network.cells[c].nucleus;
+      const double               th = u(3 * c + 2), om = v(3 * c + 2);
+      const double ux = u(3 * c) - th * r[1], uy = u(3 * c + 1) + th * r[0];
+      const double vx = v(3 * c) - om * r[1], vy = v(3 * c + 1) + om * r[0];
+      const double cell_values[8] = {p[0] + ux, p[1] + uy, ux, uy, vx, vy, th, om};
+      std::copy(cell_values, cell_values + 8, out);
+      std::fill(out + 8, out + 17, 0.0);
+      if (e < 0)
+        return;
+      const Springs &sp   = springs[e];
+      const double   area = sp.thickness * network.facets[e].length;
+      out[8]  = sp.force[0];
+      out[9]  = sp.force[1];
+      out[10] = sp.force[2];
+      out[11] = sp.force[0] / area;
+      out[12] = sp.force[1] / area;
+      for (unsigned int i = 0; i < 3; ++i)
+        out[13 + i] = sp.hysteretic && !sp.broken ? sp.law[i].h1(sp.state.data() + 3 * i) : 0.0;
+      out[16] = sp.broken ? 1.0 : 0.0;
+    }
+
+
+
+    void
+    Model::open_tables()
+    {
+      tables.open(scene, method.output_directory(), point_columns());
+      // Each probe: the cell whose nucleus is nearest (the Voronoi cell holding the
+      // point) and the facet whose midpoint is nearest.
+      probe_cell.clear();
+      probe_facet.clear();
+      for (const auto &p : scene.output_control().probe_points)
+        {
+          unsigned int best = 0;
+          for (unsigned int c = 1; c < network.cells.size(); ++c)
+            if (network.cells[c].nucleus.distance(p) < network.cells[best].nucleus.distance(p))
+              best = c;
+          probe_cell.push_back(best);
+          int facet = -1;
+          for (unsigned int e = 0; e < network.facets.size(); ++e)
+            if (facet < 0 || network.facets[e].midpoint.distance(p) < network.facets[facet].midpoint.distance(p))
+              facet = e;
+          probe_facet.push_back(facet);
+        }
+      if (!scene.is_root())
+        return;
+      if (analysis != Analysis::linear_static)
+        newton_table = std::make_unique<Output::CsvWriter>(
+          method.output_file("newton.csv"),
+          std::vector<std::string>{"time", "step", "iteration", "residual", "force_level",
+                                   "relative_residual", "line_search"});
+      if (fracture.enabled)
+        fracture_table = std::make_unique<Output::CsvWriter>(
+          method.output_file("fracture.csv"),
+          std::vector<std::string>{"time", "facet", "x", "y", "s_n", "s_t", "R"});
+    }
+
+
+
+    void
+    Model::record_break(const unsigned int e, const double t)
+    {
+      const Springs &sp   = springs[e];
+      const double   area = sp.thickness * network.facets[e].length;
+      const double   s_n = sp.trial_force[0] / area, s_t = sp.trial_force[1] / area;
+      const double   R = std::max(s_n / fracture.tensile_strength,
+                                (std::abs(s_t) + fracture.friction * s_n) / fracture.cohesion);
+      if (fracture_table)
+        fracture_table->add_row({t, double(e), network.facets[e].midpoint[0],
+                                 network.facets[e].midpoint[1], s_n, s_t, R});
+    }
+
+
+
+    void
+    Model::write_table_rows(const double t)
+    {
+      const unsigned int  n_values = point_columns().size();
+      const auto         &probes   = scene.output_control().probe_points;
+      std::vector<double> rows(probes.size() * n_values);
+      for (unsigned int i = 0; i < probes.size(); ++i)
+        point_values(probe_cell[i], probe_facet[i], probes[i], rows.data() + i * n_values);
+
+      // Averages: cell columns mass-weighted over the cells whose nucleus is in the
+      // region; facet columns the mean over the facets whose midpoint is in it.
+      const auto         &regions = scene.output_control().average_regions;
+      std::vector<double> averages(regions.size() * (1 + n_values), 0.0), values(n_values);
+      for (unsigned int r = 0; r < regions.size(); ++r)
+        {
+          double *avg = averages.data() + r * (1 + n_values);
+          for (unsigned int c = 0; c < network.cells.size(); ++c)
+            if (regions[r].contains(network.cells[c].nucleus, 1e-9 * scale))
+              {
+                point_values(c, -1, network.cells[c].nucleus, values.data());
+                avg[0] += cell_mass[c];
+                for (unsigned int k = 0; k < 8; ++k)
+                  avg[1 + k] += cell_mass[c] * values[k];
+              }
+          std::vector<unsigned int> inside;
+          for (unsigned int e = 0; e < network.facets.size(); ++e)
+            if (regions[r].contains(network.facets[e].midpoint, 1e-9 * scale))
+              inside.push_back(e);
+          for (const unsigned int e : inside)
+            {
+              point_values(network.facets[e].a, e, network.facets[e].midpoint, values.data());
+              for (unsigned int k = 8; k < n_values; ++k)
+                avg[1 + k] += avg[0] / inside.size() * values[k];
+            }
+        }
+
+      // Energies: kinetic 1/2 v^T M v, the springs' recoverable energy
+      // 1/2 a k delta^2 + 1/2 (1 - a) k z^2 (elastic: 1/2 k delta^2), and the works.
+      double kinetic = 0, strain_energy = 0;
+      for (unsigned int c = 0; c < network.cells.size() && analysis == Analysis::implicit_dynamics; ++c)
+        {
+          const double m = cell_mass[c], vx = v(3 * c), vy = v(3 * c + 1), om = v(3 * c + 2);
+          kinetic += 0.5 * (m * (vx * vx + vy * vy) + cell_inertia[c] * om * om) +
+                     om * m * (-cell_offset[c][1] * vx + cell_offset[c][0] * vy);
+        }
+      for (const auto &sp : springs)
+        if (!sp.broken)
+          for (unsigned int i = 0; i < 3; ++i)
+            {
+              if (!sp.hysteretic)
+                strain_energy += 0.5 * sp.k[i] * sp.delta[i] * sp.delta[i];
+              else
+                {
+                  const double a = sp.law[i].parameters().post_yield_ratio, z = sp.state[3 * i];
+                  strain_energy += 0.5 * a * sp.k[i] * sp.delta[i] * sp.delta[i] + 0.5 * (1 - a) * sp.k[i] * z * z;
+                }
+            }
+
+      std::vector<dealii::Tensor<1, 2>> reactions(dirichlet.size());
+      for (unsigned int i = 0; i < u.size(); ++i)
+        if (dof_set[i] >= 0 && i % 3 < 2)
+          reactions[dof_set[i]][i % 3] += f_int(i) + inertia(i) - f_ext(i);
+      tables.write(t, rows, averages,
+                   {{kinetic, strain_energy, internal_work, external_work, boundary_work}},
+                   reactions, MPI_COMM_SELF);
+    }
+
+
+
+    void
+    Model::write_vtu(std::ostream &out) const
+    {
+      // The cells as polygons (moved rigidly: point data "displacement") and the
+      // broken facets as lines, in one unstructured grid.
+      std::vector<dealii::Point<2>> points;
+      std::vector<double>           displacement;
+      std::vector<unsigned int>     offsets, connectivity;
+      std::vector<int>              types, cell_index, body;
+      std::vector<double>           theta, h1;
+      std::vector<int>              broken;
+      const auto add_point = [&](const dealii::Point<2> &p, const unsigned int c) {
+        const dealii::Tensor<1, 2> r = p - network.cells[c].nucleus;
+        const double               th = u(3 * c + 2);
+        points.push_back(p);
+        displacement.push_back(u(3 * c) - th * r[1]);
+        displacement.push_back(u(3 * c + 1) + th * r[0]);
+        connectivity.push_back(points.size() - 1);
+      };
+      std::vector<double> cell_h1(network.cells.size(), 0.0);
+      for (unsigned int e = 0; e < springs.size(); ++e)
+        if (springs[e].hysteretic && !springs[e].broken)
+          for (const unsigned int c : {network.facets[e].a, network.facets[e].b})
+            cell_h1[c] = std::max(cell_h1[c], springs[e].law[0].h1(springs[e].state.data()));
+      for (unsigned int c = 0; c < network.cells.size(); ++c)
+        for (const auto &loop : network.cells[c].outline)
+          {
+            for (const auto &p : loop)
+              add_point(p, c);
+            offsets.push_back(connectivity.size());
+            types.push_back(7); // VTK_POLYGON
+            cell_index.push_back(c);
+            body.push_back(cell_body[c]);
+            theta.push_back(u(3 * c + 2));
+            h1.push_back(cell_h1[c]);
+            broken.push_back(0);
+          }
+      for (unsigned int e = 0; e < springs.size(); ++e)
+        if (springs[e].broken)
+          {
+            add_point(network.facets[e].p3, network.facets[e].a);
+            add_point(network.facets[e].p4, network.facets[e].a);
+            offsets.push_back(connectivity.size());
+            types.push_back(3); // VTK_LINE
+            cell_index.push_back(-1);
+            body.push_back(cell_body[network.facets[e].a]);
+            theta.push_back(0);
+            h1.push_back(0);
+            broken.push_back(1);
+          }
+      out.precision(10);
+      out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+             "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\""
+          << points.size() << "\" NumberOfCells=\"" << types.size() << "\">\n<Points>\n"
+          << "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+      for (const auto &p : points)
+        out << p[0] << ' ' << p[1] << " 0\n";
+      out << "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" "
+             "format=\"ascii\">\n";
+      for (const auto i : connectivity)
+        out << i << ' ';
+      out << "\n</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+      for (const auto i : offsets)
+        out << i << ' ';
+      out << "\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+      for (const auto i : types)
+        out << i << ' ';
+      out << "\n</DataArray>\n</Cells>\n<PointData Vectors=\"displacement\">\n"
+          << "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+      for (unsigned int k = 0; k < points.size(); ++k)
+        out << displacement[2 * k] << ' ' << displacement[2 * k + 1] << " 0\n";
+      out << "</DataArray>\n</PointData>\n<CellData>\n";
+      const auto integers = [&](const char *name, const std::vector<int> &values) {
+        out << "<DataArray type=\"Int32\" Name=\"" << name << "\" format=\"ascii\">\n";
+        for (const auto x : values)
+          out << x << ' ';
+        out << "\n</DataArray>\n";
+      };
+      const auto reals = [&](const char *name, const std::vector<double> &values) {
+        out << "<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
+        for (const auto x : values)
+          out << x << ' ';
+        out << "\n</DataArray>\n";
+      };
+      integers("cell", cell_index);
+      integers("body", body);
+      integers("broken", broken);
+      reals("rotation", theta);
+      reals("H1", h1);
+      out << "</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+    }
+
+
+
+    void
+    Model::write_fields(const double t)
+    {
+      if (!scene.output_control().write_vtu)
+        return;
+      field_writer->write_serial([this](std::ostream &out) { write_vtu(out); }, t);
+      ++n_outputs;
+    }
+
+
+
+    void
+    Model::commit_tables()
+    {
+      tables.commit();
+      for (auto *table : {newton_table.get(), fracture_table.get()})
+        if (table)
+          table->commit();
+    }
+
+
+
+    void
+    Model::write_spring_table() const
+    {
+      if (!scene.is_root())
+        return;
+      Output::CsvWriter out(method.output_file("springs.csv"),
+                            {"a", "b", "x", "y", "n_x", "n_y", "length", "distance", "thickness",
+                             "k_n", "k_t", "k_phi",
+                             "delta_n", "delta_t", "phi", "f_n", "f_t", "m", "H1_n", "H1_t", "H1_m",
+                             "broken"});
+      for (unsigned int e = 0; e < springs.size(); ++e)
+        {
+          const Facet   &f  = network.facets[e];
+          const Springs &sp = springs[e];
+          std::vector<double> row{double(f.a), double(f.b), f.midpoint[0], f.midpoint[1], f.normal[0],
+                                  f.normal[1], f.length, f.distance, sp.thickness, sp.k[0], sp.k[1],
+                                  sp.k[2], sp.delta[0], sp.delta[1],
+                                  sp.delta[2], sp.force[0], sp.force[1], sp.force[2]};
+          for (unsigned int i = 0; i < 3; ++i)
+            row.push_back(sp.hysteretic && !sp.broken ? sp.law[i].h1(sp.state.data() + 3 * i) : 0.0);
+          row.push_back(sp.broken ? 1 : 0);
+          out.add_row(row);
+        }
+      out.commit();
+    }
+  } // namespace RBSN
+} // namespace hysteron

@@ -1,0 +1,564 @@
+#include <deal.II/lac/full_matrix.h>
+
+#include <hysteron/base/progress.h>
+#include <hysteron/rbsn/model.h>
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace hysteron
+{
+  namespace RBSN
+  {
+    /*
+     * The equations. For facet e between cells a and b with U_e = (u_a, v_a,
+     * theta_a, u_b, v_b, theta_b), the springs' deformations are
+     * delta = (B_n U_e, B_t U_e, theta_b - theta_a) and their forces F_i(delta_i)
+     * (linear, or the uniaxial Bouc-Wen law from the converged state, eq. 3.32);
+     *   f_int = sum_e B^T F,   K = sum_e B^T diag(dF_i / d delta_i) B    (eq. 3.10, 3.31).
+     * Quasi-static: r = f_int(u) - f_ext(t). Dynamics (HHT-alpha, Newmark for
+     * alpha = 0, as the FEM): with the cell mass matrices M_c of eq. 3.12 and
+     * C = a0 M + a1 K0 (K0: the elastic springs),
+     *   r = M a1 + (1 + alpha)(C v1 + f_int(u1) - f_ext(t1)) - alpha (C v0 + f_int(u0) - f_ext(t0)).
+     */
+    bool
+    Model::assemble(const double t1, const double dt, const bool with_matrix, const bool update_springs)
+    {
+      const bool   dynamic = analysis == Analysis::implicit_dynamics && dt > 0;
+      const double alpha = hht_alpha, beta = (1 - alpha) * (1 - alpha) / 4, gamma = 0.5 - alpha;
+      if (with_matrix)
+        matrix = 0;
+      rhs     = 0;
+      f_int   = 0;
+      inertia = 0;
+      external_forces(t1, f_ext);
+
+      dealii::FullMatrix<double>                K(6, 6), K0(6, 6);
+      dealii::Vector<double>                    r(6), fe(6), fe0(6), ue(6), ve0(6), ve1(6), tmp(6);
+      std::vector<dealii::types::global_dof_index> dofs(6);
+      bool        failed = false;
+      std::string message;
+      for (unsigned int e = 0; e < springs.size(); ++e)
+        {
+          Springs &sp = springs[e];
+          if (sp.broken)
+            continue;
+          const Facet &f = network.facets[e];
+          for (unsigned int k = 0; k < 3; ++k)
+            {
+              dofs[k]     = 3 * f.a + k;
+              dofs[3 + k] = 3 * f.b + k;
+            }
+          for (unsigned int k = 0; k < 6; ++k)
+            ue[k] = u_trial(dofs[k]);
+          const std::array<const double *, 3> rows{{sp.B_n.data(), sp.B_t.data(), nullptr}};
+          const auto apply = [&](const unsigned int i, const dealii::Vector<double> &x) {
+            if (i == 2)
+              return x[5] - x[2];
+            double s = 0;
+            for (unsigned int k = 0; k < 6; ++k)
+              s += rows[i][k] * x[k];
+            return s;
+          };
+          const auto row = [&](const unsigned int i, const unsigned int k) {
+            return i == 2 ? (k == 5 ? 1.0 : k == 2 ? -1.0 : 0.0) : rows[i][k];
+          };
+          for (unsigned int i = 0; i < 3; ++i)
+            {
+              sp.trial_delta[i] = apply(i, ue);
+              const double increment = sp.trial_delta[i] - sp.delta[i];
+              if (!update_springs)
+                {
+                  sp.trial_force[i] = sp.force[i];
+                  continue;
+                }
+              if (!sp.hysteretic)
+                {
+                  sp.trial_force[i] = sp.k[i] * sp.trial_delta[i];
+                  sp.tangent[i]     = sp.k[i];
+                  continue;
+                }
+              sp.trial_force[i] = sp.force[i];
+              std::copy(sp.state.begin() + 3 * i, sp.state.begin() + 3 * i + 3, sp.trial_state.begin() + 3 * i);
+              try
+                {
+                  sp.law[i].update(increment, sp.trial_force[i], sp.trial_state.data() + 3 * i,
+                                   with_matrix ? &sp.tangent[i] : nullptr);
+                }
+              catch (const RuntimeError &error)
+                {
+                  failed = true;
+                  std::ostringstream m;
+                  m << error.what() << " (the " << (i == 0 ? "normal" : i == 1 ? "tangential" : "rotational")
+                    << " spring of the facet at " << f.midpoint << ", step to t = " << t1 << " s)";
+                  message = m.str();
+                }
+            }
+          if (failed)
+            continue;
+          for (unsigned int k = 0; k < 6; ++k)
+            {
+              fe[k] = 0;
+              for (unsigned int i = 0; i < 3; ++i)
+                fe[k] += row(i, k) * sp.trial_force[i];
+            }
+          if (with_matrix)
+            for (unsigned int p = 0; p < 6; ++p)
+              for (unsigned int q = 0; q < 6; ++q)
+                {
+                  K(p, q) = 0;
+                  for (unsigned int i = 0; i < 3; ++i)
+                    K(p, q) += row(i, p) * sp.tangent[i] * row(i, q);
+                }
+          r = fe;
+          if (dynamic)
+            {
+              // HHT weights of the springs, and the stiffness-proportional damping a1 K0 v.
+              for (unsigned int k = 0; k < 6; ++k)
+                {
+                  fe0[k] = 0;
+                  for (unsigned int i = 0; i < 3; ++i)
+                    fe0[k] += row(i, k) * sp.force[i];
+                }
+              r *= 1 + alpha;
+              r.add(-alpha, fe0);
+              if (with_matrix)
+                K *= 1 + alpha;
+              if (rayleigh_stiffness > 0)
+                {
+                  for (unsigned int p = 0; p < 6; ++p)
+                    for (unsigned int q = 0; q < 6; ++q)
+                      {
+                        K0(p, q) = 0;
+                        for (unsigned int i = 0; i < 3; ++i)
+                          K0(p, q) += row(i, p) * sp.k[i] * row(i, q);
+                      }
+                  for (unsigned int k = 0; k < 6; ++k)
+                    {
+                      ve0[k]          = v(dofs[k]);
+                      const double a1 = (ue[k] - u(dofs[k]) - dt * ve0[k]) / (beta * dt * dt) -
+                                        (1 - 2 * beta) / (2 * beta) * a(dofs[k]);
+                      ve1[k] = ve0[k] + dt * ((1 - gamma) * a(dofs[k]) + gamma * a1);
+                    }
+                  K0.vmult(tmp, ve1);
+                  r.add((1 + alpha) * rayleigh_stiffness, tmp);
+                  for (unsigned int k = 0; k < 6; ++k)
+                    inertia(dofs[k]) += rayleigh_stiffness * tmp[k];
+                  K0.vmult(tmp, ve0);
+                  r.add(-alpha * rayleigh_stiffness, tmp);
+                  if (with_matrix)
+                    K.add((1 + alpha) * gamma / (beta * dt) * rayleigh_stiffness, K0);
+                }
+            }
+          for (unsigned int k = 0; k < 6; ++k)
+            f_int(dofs[k]) += fe[k];
+          r *= -1.0;
+          if (with_matrix)
+            constraints.distribute_local_to_global(K, r, dofs, matrix, rhs, true);
+          else
+            constraints.distribute_local_to_global(r, dofs, rhs);
+        }
+
+      if (dynamic)
+        {
+          // The cells: M a1 + (1 + alpha) a0 M v1 - alpha a0 M v0, tangent c_M M.
+          dealii::FullMatrix<double>                   M(3, 3);
+          dealii::Vector<double>                       a1(3), v1(3), v0(3), rc(3), Mx(3);
+          std::vector<dealii::types::global_dof_index> cd(3);
+          const double c_M = 1 / (beta * dt * dt) + (1 + alpha) * gamma / (beta * dt) * rayleigh_mass;
+          for (unsigned int c = 0; c < network.cells.size(); ++c)
+            {
+              const double m = cell_mass[c], ox = cell_offset[c][0], oy = cell_offset[c][1];
+              M(0, 0) = M(1, 1) = m;
+              M(0, 1) = M(1, 0) = 0;
+              M(0, 2) = M(2, 0) = -m * oy;
+              M(1, 2) = M(2, 1) = m * ox;
+              M(2, 2)           = cell_inertia[c];
+              for (unsigned int k = 0; k < 3; ++k)
+                {
+                  cd[k]       = 3 * c + k;
+                  v0[k]       = v(cd[k]);
+                  const double du = u_trial(cd[k]) - u(cd[k]);
+                  a1[k]       = (du - dt * v0[k]) / (beta * dt * dt) - (1 - 2 * beta) / (2 * beta) * a(cd[k]);
+                  v1[k]       = v0[k] + dt * ((1 - gamma) * a(cd[k]) + gamma * a1[k]);
+                }
+              M.vmult(rc, a1);
+              M.vmult(Mx, v1);
+              for (unsigned int k = 0; k < 3; ++k)
+                inertia(cd[k]) += rc[k] + rayleigh_mass * Mx[k];
+              rc.add((1 + alpha) * rayleigh_mass, Mx);
+              M.vmult(Mx, v0);
+              rc.add(-alpha * rayleigh_mass, Mx);
+              rc *= -1.0;
+              if (with_matrix)
+                {
+                  dealii::FullMatrix<double> A(3, 3);
+                  A.add(c_M, M);
+                  constraints.distribute_local_to_global(A, rc, cd, matrix, rhs, true);
+                }
+              else
+                constraints.distribute_local_to_global(rc, cd, rhs);
+            }
+        }
+
+      // The external forces (HHT-weighted) on the free DoFs.
+      for (unsigned int i = 0; i < rhs.size(); ++i)
+        if (!constraints.is_constrained(i))
+          rhs(i) += dynamic ? (1 + alpha) * f_ext(i) - alpha * f_ext_old(i) : f_ext(i);
+
+      if (failed)
+        {
+          spring_failure = message;
+          return false;
+        }
+      last_force_level = std::max({f_int.l2_norm(), f_ext.l2_norm(), inertia.l2_norm()});
+      return std::isfinite(last_force_level) && std::isfinite(rhs.l2_norm());
+    }
+
+
+
+    bool
+    Model::solve_step(const double t, const double dt)
+    {
+      const double t1 = t + dt;
+      spring_failure.clear();
+      Vector du(u.size());
+      // Predictor: the tangent of the converged state, the prescribed increments as
+      // inhomogeneous constraints.
+      make_constraints(t, t1, true);
+      u_trial = u;
+      // (Bouc-Wen springs keep the tangents of their last evaluation.)
+      if (!assemble(t1, dt, true, analysis == Analysis::linear_static))
+        return false;
+      // The out-of-balance force of the prescribed increments: the force level of a
+      // step that moves the network without loading it (a rigid motion).
+      predictor_level = rhs.l2_norm();
+      solve_linear(du);
+      constraints.distribute(du);
+      make_constraints(t, t1, false);
+      u_trial += du;
+      if (!assemble(t1, dt, true, true))
+        return false;
+      if (newton_table)
+        newton_table->add_row({t1, dt, 0.0, rhs.l2_norm(), force_level(), rhs.l2_norm() / std::max(force_level(), 1e-300), 1.0});
+
+      struct Problem : NewtonProblem
+      {
+        Model       &m;
+        double       t1, dt;
+        Vector       du, start;
+        Problem(Model &m, const double t1, const double dt)
+          : m(m), t1(t1), dt(dt), du(m.u.size()), start(m.u.size())
+        {}
+        bool
+        evaluate(const bool with_matrix) override
+        {
+          return m.assemble(t1, dt, with_matrix, true);
+        }
+        double
+        residual() const override
+        {
+          return m.rhs.l2_norm();
+        }
+        double
+        force_level() const override
+        {
+          return m.force_level();
+        }
+        void
+        solve_correction() override
+        {
+          m.solve_linear(du);
+          m.constraints.distribute(du);
+        }
+        void
+        remember_start() override
+        {
+          start = m.u_trial;
+        }
+        void
+        move(const double alpha) override
+        {
+          m.u_trial = start;
+          m.u_trial.add(alpha, du);
+        }
+        void
+        log(const unsigned int iteration, const double residual, const double alpha) override
+        {
+          if (m.newton_table)
+            m.newton_table->add_row({t1, dt, double(iteration), residual, force_level(),
+                                     residual / std::max(force_level(), 1e-300), alpha});
+        }
+      } problem(*this, t1, dt);
+      const double       floor      = 64 * std::numeric_limits<double>::epsilon() * std::sqrt(double(u.size()));
+      const unsigned int iterations = newton_iterate(problem, newton, floor);
+      n_newton += iterations > 0 ? iterations : newton.max_iterations;
+      return iterations > 0;
+    }
+
+
+
+    void
+    Model::commit(const double t1, const double dt)
+    {
+      (void)t1;
+      for (auto &sp : springs)
+        {
+          if (sp.broken)
+            continue;
+          for (unsigned int i = 0; i < 3; ++i)
+            internal_work += 0.5 * (sp.force[i] + sp.trial_force[i]) * (sp.trial_delta[i] - sp.delta[i]);
+          sp.delta = sp.trial_delta;
+          sp.force = sp.trial_force;
+          sp.state = sp.trial_state;
+        }
+      Vector increment = u_trial;
+      increment -= u;
+      if (analysis == Analysis::implicit_dynamics && dt > 0)
+        {
+          const double alpha = hht_alpha, beta = (1 - alpha) * (1 - alpha) / 4, gamma = 0.5 - alpha;
+          for (unsigned int i = 0; i < u.size(); ++i)
+            {
+              const double a1 = (increment(i) - dt * v(i)) / (beta * dt * dt) - (1 - 2 * beta) / (2 * beta) * a(i);
+              v(i) += dt * ((1 - gamma) * a(i) + gamma * a1);
+              a(i) = a1;
+            }
+        }
+      else if (dt > 0)
+        {
+          v = increment;
+          v /= dt;
+        }
+      for (unsigned int i = 0; i < u.size(); ++i)
+        external_work += 0.5 * (f_ext_old(i) + f_ext(i)) * increment(i);
+      Vector reaction = f_int;
+      reaction += inertia;
+      reaction -= f_ext;
+      for (unsigned int i = 0; i < u.size(); ++i)
+        if (dof_set[i] >= 0)
+          boundary_work += 0.5 * (reaction_old(i) + reaction(i)) * increment(i);
+      reaction_old = reaction;
+      f_ext_old    = f_ext;
+      force_scale  = std::max(force_scale, last_force_level);
+      u            = u_trial;
+    }
+
+
+
+    int
+    Model::facet_to_break() const
+    {
+      // R = max(s_n / f_t, (|s_t| + tan(phi) s_n) / c): the distance to the Mohr-Coulomb
+      // surface with a tension cut-off along the ray from the origin (eq. 3.50-3.51).
+      int    worst = -1;
+      double R_max = 1;
+      for (unsigned int e = 0; e < springs.size(); ++e)
+        {
+          const Springs &sp = springs[e];
+          if (sp.broken)
+            continue;
+          const double area = sp.thickness * network.facets[e].length;
+          const double s_n = sp.trial_force[0] / area, s_t = sp.trial_force[1] / area;
+          const double R   = std::max(s_n / fracture.tensile_strength,
+                                    (std::abs(s_t) + fracture.friction * s_n) / fracture.cohesion);
+          if (R > R_max)
+            {
+              R_max = R;
+              worst = e;
+            }
+        }
+      return worst;
+    }
+
+
+
+    void
+    Model::initial_state()
+    {
+      // Velocities of the nuclei from the bodies' initial velocity (the cells
+      // translate; prescribed DoFs move with their conditions), and M a0 = f_ext(0)
+      // - f_int(0) - C v0 on the free DoFs.
+      const auto &bodies = scene.body_descriptions();
+      for (unsigned int c = 0; c < network.cells.size(); ++c)
+        {
+          const auto w = bodies[cell_body[c]].velocity_at(network.cells[c].nucleus);
+          v(3 * c)     = w[0];
+          v(3 * c + 1) = w[1];
+        }
+      for (unsigned int i = 0; i < v.size(); ++i)
+        if (dof_set[i] >= 0)
+          v(i) = 0;
+      make_constraints(0, 0, false);
+      matrix = 0;
+      rhs    = 0;
+      dealii::FullMatrix<double>                   M(3, 3);
+      dealii::Vector<double>                       zero(3);
+      std::vector<dealii::types::global_dof_index> cd(3);
+      for (unsigned int c = 0; c < network.cells.size(); ++c)
+        {
+          const double m = cell_mass[c], ox = cell_offset[c][0], oy = cell_offset[c][1];
+          M       = 0;
+          M(0, 0) = M(1, 1) = m;
+          M(0, 2) = M(2, 0) = -m * oy;
+          M(1, 2) = M(2, 1) = m * ox;
+          M(2, 2)           = cell_inertia[c];
+          for (unsigned int k = 0; k < 3; ++k)
+            cd[k] = 3 * c + k;
+          constraints.distribute_local_to_global(M, zero, cd, matrix, rhs);
+        }
+      // C v0 = a0 M v0 + a1 K0 v0.
+      Vector force = f_ext;
+      force -= f_int;
+      Vector Mv(v.size());
+      matrix.vmult(Mv, v);
+      force.add(-rayleigh_mass, Mv);
+      if (rayleigh_stiffness > 0)
+        for (unsigned int e = 0; e < springs.size(); ++e)
+          {
+            const Facet   &f  = network.facets[e];
+            const Springs &sp = springs[e];
+            const double   U[6] = {v(3 * f.a), v(3 * f.a + 1), v(3 * f.a + 2), v(3 * f.b), v(3 * f.b + 1), v(3 * f.b + 2)};
+            double         dn = 0, dt = 0;
+            for (unsigned int k = 0; k < 6; ++k)
+              {
+                dn += sp.B_n[k] * U[k];
+                dt += sp.B_t[k] * U[k];
+              }
+            const double dphi = U[5] - U[2];
+            for (unsigned int k = 0; k < 6; ++k)
+              {
+                const double phi_row = k == 5 ? 1.0 : k == 2 ? -1.0 : 0.0;
+                const double Kv = sp.B_n[k] * sp.k[0] * dn + sp.B_t[k] * sp.k[1] * dt + phi_row * sp.k[2] * dphi;
+                force(k < 3 ? 3 * f.a + k : 3 * f.b + k - 3) -= rayleigh_stiffness * Kv;
+              }
+          }
+      for (unsigned int i = 0; i < rhs.size(); ++i)
+        if (!constraints.is_constrained(i))
+          rhs(i) = force(i);
+      solve_linear(a);
+      constraints.distribute(a);
+    }
+
+
+
+    void
+    Model::run()
+    {
+      const auto &time = scene.time_control();
+      {
+        dealii::TimerOutput::Scope timing(scene.timer(), "set-up");
+        build_network();
+        setup_springs();
+        setup_system();
+        setup_conditions();
+        field_writer = std::make_unique<Output::FieldWriter>(method.output_directory(), "rbsn",
+                                                             MPI_COMM_SELF);
+        open_tables();
+      }
+      scene.console() << "rbsn: " << network.cells.size() << " cells, " << network.facets.size()
+                      << " facets (d_m = " << d_m << " m), " << 3 * network.cells.size() << " DoFs"
+                      << std::endl;
+      if (analysis != Analysis::linear_static && !consistent_tangent && scene.is_root())
+        std::cerr << "hysteron: warning: RBSN: the springs' tangent is not the algorithmic one "
+                     "(Bouc-Wen: Integrator = adaptive or forward euler), so Newton converges "
+                     "linearly; Integrator = backward euler gives quadratic convergence"
+                  << std::endl;
+
+      double t = 0;
+      // The initial state: forces at t = 0, and the initial acceleration in dynamics.
+      make_constraints(0, 0, false);
+      u_trial = u;
+      assemble(0, 0, false, true);
+      f_ext_old    = f_ext;
+      reaction_old = f_int;
+      reaction_old -= f_ext;
+      if (analysis == Analysis::implicit_dynamics)
+        initial_state();
+      write_fields(t);
+      write_table_rows(t);
+
+      double nominal = time_step > 0 ? time_step : time.time_step;
+      if (nominal == 0)
+        nominal = time.end_time / n_increments;
+      IncrementControl    increments(nominal, newton.max_cuts);
+      PointData::Schedule rows(scene.output_control().probe_interval, time.end_time);
+      PointData::Schedule fields(scene.output_control().interval, time.end_time);
+      Progress progress(scene.console(), "rbsn", time.end_time, scene.output_control().progress_interval);
+      const double eps = 1e-12 * time.end_time;
+      while (t < time.end_time - eps)
+        {
+          const double dt = increments.step(t, time.end_time);
+          bool         converged = false;
+          {
+            dealii::TimerOutput::Scope timing(scene.timer(), "steps");
+            try
+              {
+                converged = solve_step(t, dt);
+              }
+            catch (const RuntimeError &error)
+              {
+                fail(std::string(error.what()) + " (step to t = " + std::to_string(t + dt) + " s).", t);
+              }
+            // Fracture: break the facet with the largest R > 1, solve the step again.
+            for (unsigned int cycle = 0; converged && fracture.enabled; ++cycle)
+              {
+                const int e = facet_to_break();
+                if (e < 0)
+                  break;
+                if (cycle >= fracture.max_cycles)
+                  fail("rbsn: more than " + std::to_string(fracture.max_cycles) +
+                         " facets break in the step to t = " + std::to_string(t + dt) +
+                         " s: the network falls apart.",
+                       t);
+                record_break(e, t + dt);
+                springs[e].broken = true;
+                ++n_broken;
+                try
+                  {
+                    converged = solve_step(t, dt);
+                  }
+                catch (const RuntimeError &error)
+                  {
+                    std::ostringstream where;
+                    where << network.facets[e].midpoint;
+                    fail(std::string(error.what()) + " after the facet at (" + where.str() +
+                           ") broke at t = " +
+                           std::to_string(t + dt) + " s: the structure has fallen apart.",
+                         t);
+                  }
+              }
+          }
+          if (!converged)
+            {
+              if (!increments.cut())
+                {
+                  std::ostringstream m;
+                  m << "rbsn: Newton did not converge in the increment from t = " << t << " s to "
+                    << t + dt << " s after " << newton.max_cuts << " cuts: the structure may have "
+                    << "reached its limit load (use displacement control)";
+                  if (!spring_failure.empty())
+                    m << "; the last failure was in a spring: " << spring_failure;
+                  m << ".";
+                  fail(m.str(), t);
+                }
+              continue;
+            }
+          commit(t + dt, dt);
+          increments.accept(t, dt);
+          n_cuts = increments.cuts();
+          ++n_steps;
+          const bool last = !(t < time.end_time - eps);
+          if (rows.due(t, last))
+            write_table_rows(t);
+          if (fields.due(t, last))
+            write_fields(t);
+          progress.update(n_steps, t);
+        }
+      progress.finish(n_steps, t);
+      commit_tables();
+      if (spring_table)
+        write_spring_table();
+    }
+  } // namespace RBSN
+} // namespace hysteron
