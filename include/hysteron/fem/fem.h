@@ -237,11 +237,13 @@ namespace hysteron
         return load_regions[l]->contains(x, 1e-9 * u_scale);
       }
 
-      /// The force level of the last evaluation that Newton's tolerance refers to.
+      /// The force level of the last evaluation that Newton's tolerance refers to (at
+      /// least 1e-3 of the largest so far, so that unloading converges, and 1e-6 of the
+      /// predictor's out-of-balance force, so that a motion without load converges).
       double
       force_level() const
       {
-        return std::max({last_force_level, 1e-3 * force_scale, predictor_level});
+        return std::max({last_force_level, 1e-3 * force_scale, 1e-6 * predictor_level});
       }
 
       /// The round-off floor 64 eps sqrt(N) of a residual of N entries, relative to

@@ -129,11 +129,12 @@ namespace hysteron
       /// Initial velocities and accelerations (implicit dynamics).
       void
       initial_state();
-      /// Newton's force level: the last evaluation's, at least 1e-3 of the largest so far.
+      /// Newton's force level: the last evaluation's, at least 1e-3 of the largest so far
+      /// and 1e-6 of the predictor's out-of-balance force (a motion without load).
       double
       force_level() const
       {
-        return std::max({last_force_level, 1e-3 * force_scale, predictor_level});
+        return std::max({last_force_level, 1e-3 * force_scale, 1e-6 * predictor_level});
       }
       void
       record_break(const unsigned int facet, const double t);
