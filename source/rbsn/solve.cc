@@ -520,6 +520,9 @@ namespace hysteron
                   }
                 catch (const RuntimeError &error)
                   {
+                    // The last good state (t) had the facet intact; the break is in fracture.csv.
+                    springs[e].broken = false;
+                    --n_broken;
                     std::ostringstream where;
                     where << network.facets[e].midpoint;
                     fail(std::string(error.what()) + " after the facet at (" + where.str() +
