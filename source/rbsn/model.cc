@@ -85,16 +85,21 @@ namespace hysteron
                           "springs yield at sigma_y t l and sigma_y t l / sqrt(3).");
         prm.declare_entry("Analysis",
                           "quasi-static",
-                          Patterns::Selection("static|quasi-static|implicit dynamics"),
+                          Patterns::Selection("static|quasi-static|implicit dynamics|variable order"),
                           "static: elastic springs (the material's plasticity ignored), one "
                           "linear solve per step; quasi-static: Bouc-Wen springs, load stepping "
                           "with Newton; implicit dynamics: Newmark / HHT-alpha with Newton (mass "
-                          "matrix eq. 3.12, Rayleigh damping).");
+                          "matrix eq. 3.12, Rayleigh damping); variable order: the state-space "
+                          "system of eq. 3.43-3.48 (displacements, velocities and the springs' "
+                          "Bouc-Wen states) integrated by SUNDIALS IDA, variable-order (1-5) "
+                          "variable-step BDF with error control (subsection Variable order; the "
+                          "Bouc-Wen Integrator is not used; no fracture).");
         prm.declare_entry("Time step",
                           "0",
                           Patterns::Double(),
                           "Step [s], >= 0; 0: Time/Time step if > 0, else End time / Number of "
-                          "increments. Newton failures halve it.");
+                          "increments. Newton failures halve it. Variable order: the interval "
+                          "between the outputs (IDA chooses its own steps).");
         prm.declare_entry("Number of increments", "100", Patterns::Integer(1), "See Time step.");
         prm.declare_entry("Write spring table",
                           "false",
@@ -133,6 +138,7 @@ namespace hysteron
                             "than this in one step stop the run.");
         }
         prm.leave_subsection();
+        declare_variable_order_parameters(prm);
       }
       prm.leave_subsection();
     }
@@ -154,9 +160,10 @@ namespace hysteron
         shear_ratio  = s.get_non_negative("Shear stiffness ratio");
         moment_yield = s.get_positive("Moment yield factor");
         const std::string type = s.get("Analysis");
-        analysis = type == "static" ? Analysis::linear_static :
-                   type == "quasi-static" ? Analysis::quasi_static :
-                                            Analysis::implicit_dynamics;
+        analysis = type == "static"            ? Analysis::linear_static :
+                   type == "quasi-static"      ? Analysis::quasi_static :
+                   type == "implicit dynamics" ? Analysis::implicit_dynamics :
+                                                 Analysis::variable_order;
         time_step    = s.get_non_negative("Time step");
         n_increments = s.get_integer("Number of increments");
         spring_table = s.get_bool("Write spring table");
@@ -184,6 +191,7 @@ namespace hysteron
             fracture.max_cycles = s.get_integer("Maximum breaks per step");
           }
       }
+      parse_variable_order_parameters(prm);
 
       const auto &bodies = scene.body_descriptions();
       require(!bodies.empty(), "Body names", "the rbsn method needs at least one body");
@@ -202,7 +210,7 @@ namespace hysteron
                     "the rbsn method's springs follow the uniaxial Bouc-Wen law: the body's "
                     "material must be 'bouc-wen' or 'linear elastic'");
             consistent_tangent = consistent_tangent && m.has_consistent_tangent();
-            require(bodies[b].initial_velocity == nullptr || analysis == Analysis::implicit_dynamics,
+            require(bodies[b].initial_velocity == nullptr || dynamic(),
                     "Body " + bodies[b].name + "/Initial velocity",
                     "only dynamic analyses have velocities");
           }
@@ -491,7 +499,6 @@ namespace hysteron
     void
     Model::make_constraints(const double t0, const double t1, const bool predictor)
     {
-      const auto &bodies = scene.body_descriptions();
       constraints.clear();
       for (unsigned int s = 0; s < dirichlet.size(); ++s)
         {
@@ -499,32 +506,50 @@ namespace hysteron
           for (const unsigned int dof : set.dofs)
             {
               constraints.add_line(dof);
-              if (!predictor)
-                continue;
-              const unsigned int c = dof / 3, k = dof % 3;
-              double             increment = 0;
-              if (set.rigid >= 0)
-                increment = k < 2 ? integrate_in_time<2>(*bodies[set.rigid].rigid_velocity, t0, t1)[k] : 0.0;
-              else
-                {
-                  const auto &d = scene.boundary_descriptions()[set.boundary];
-                  const auto &x = network.cells[c].nucleus;
-                  if (k < 2 && (d.velocity || d.displacement))
-                    increment = d.displacement_increment(t0, t1, x)[k];
-                  else if (k == 2 && d.displacement)
-                    {
-                      // The rotation 1/2 (du_y/dx - du_x/dy) of the field, by central differences.
-                      const double e = 1e-4 * scale;
-                      const auto   du = [&](const double dx, const double dy) {
-                        return d.displacement_increment(t0, t1, x + dealii::Tensor<1, 2>({dx, dy}));
-                      };
-                      increment = 0.25 / e * ((du(e, 0)[1] - du(-e, 0)[1]) - (du(0, e)[0] - du(0, -e)[0]));
-                    }
-                }
-              constraints.set_inhomogeneity(dof, increment);
+              if (predictor)
+                constraints.set_inhomogeneity(dof, prescribed_increment(set, dof, t0, t1));
             }
         }
       constraints.close();
+    }
+
+
+
+    double
+    Model::prescribed_increment(const Dirichlet &set, const unsigned int dof, const double t0, const double t1) const
+    {
+      const unsigned int c = dof / 3, k = dof % 3;
+      if (set.rigid >= 0)
+        return k < 2 ? integrate_in_time<2>(*scene.body_descriptions()[set.rigid].rigid_velocity, t0, t1)[k] : 0.0;
+      const auto &d = scene.boundary_descriptions()[set.boundary];
+      const auto &x = network.cells[c].nucleus;
+      if (k < 2 && (d.velocity || d.displacement))
+        return d.displacement_increment(t0, t1, x)[k];
+      if (k == 2 && d.displacement)
+        {
+          // The rotation 1/2 (du_y/dx - du_x/dy) of the field, by central differences.
+          const double e  = 1e-4 * scale;
+          const auto   du = [&](const double dx, const double dy) {
+            return d.displacement_increment(t0, t1, x + dealii::Tensor<1, 2>({dx, dy}));
+          };
+          return 0.25 / e * ((du(e, 0)[1] - du(-e, 0)[1]) - (du(0, e)[0] - du(0, -e)[0]));
+        }
+      return 0;
+    }
+
+
+
+    void
+    Model::cell_mass_matrix(const unsigned int c, dealii::FullMatrix<double> &M) const
+    {
+      // Rigid cell of mass m, centroid at o from the nucleus, polar moment I about the
+      // nucleus: the kinetic energy 1/2 m |v + omega x o|^2 + 1/2 I_c omega^2 (eq. 3.12).
+      const double m = cell_mass[c], ox = cell_offset[c][0], oy = cell_offset[c][1];
+      M.reinit(3, 3);
+      M(0, 0) = M(1, 1) = m;
+      M(0, 2) = M(2, 0) = -m * oy;
+      M(1, 2) = M(2, 1) = m * ox;
+      M(2, 2)           = cell_inertia[c];
     }
 
 

@@ -68,7 +68,13 @@ namespace hysteron
         }
       if (!scene.is_root())
         return;
-      if (analysis != Analysis::linear_static)
+      if (analysis == Analysis::variable_order)
+        newton_table = std::make_unique<Output::CsvWriter>(
+          method.output_file("ida.csv"),
+          std::vector<std::string>{"time", "steps", "order", "step", "residuals", "jacobians",
+                                   "nonlinear_iterations", "error_test_failures",
+                                   "convergence_failures"});
+      else if (analysis != Analysis::linear_static)
         newton_table = std::make_unique<Output::CsvWriter>(
           method.output_file("newton.csv"),
           std::vector<std::string>{"time", "step", "iteration", "residual", "force_level",
@@ -135,7 +141,7 @@ namespace hysteron
       // Energies: kinetic 1/2 v^T M v, the springs' recoverable energy
       // 1/2 a k delta^2 + 1/2 (1 - a) k z^2 (elastic: 1/2 k delta^2), and the works.
       double kinetic = 0, strain_energy = 0;
-      for (unsigned int c = 0; c < network.cells.size() && analysis == Analysis::implicit_dynamics; ++c)
+      for (unsigned int c = 0; c < network.cells.size() && dynamic(); ++c)
         {
           const double m = cell_mass[c], vx = v(3 * c), vy = v(3 * c + 1), om = v(3 * c + 2);
           kinetic += 0.5 * (m * (vx * vx + vy * vy) + cell_inertia[c] * om * om) +

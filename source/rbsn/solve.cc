@@ -459,7 +459,8 @@ namespace hysteron
       scene.console() << "rbsn: " << network.cells.size() << " cells, " << network.facets.size()
                       << " facets (d_m = " << d_m << " m), " << 3 * network.cells.size() << " DoFs"
                       << std::endl;
-      if (analysis != Analysis::linear_static && !consistent_tangent && scene.is_root())
+      if ((analysis == Analysis::quasi_static || analysis == Analysis::implicit_dynamics) &&
+          !consistent_tangent && scene.is_root())
         std::cerr << "hysteron: warning: RBSN: the springs' tangent is not the algorithmic one "
                      "(Bouc-Wen: Integrator = adaptive or forward euler), so Newton converges "
                      "linearly; Integrator = backward euler gives quadratic convergence"
@@ -473,7 +474,7 @@ namespace hysteron
       f_ext_old    = f_ext;
       reaction_old = f_int;
       reaction_old -= f_ext;
-      if (analysis == Analysis::implicit_dynamics)
+      if (dynamic())
         initial_state();
       write_fields(t);
       write_table_rows(t);
@@ -485,6 +486,8 @@ namespace hysteron
       PointData::Schedule rows(scene.output_control().probe_interval, time.end_time);
       PointData::Schedule fields(scene.output_control().interval, time.end_time);
       Progress progress(scene.console(), "rbsn", time.end_time, scene.output_control().progress_interval);
+      if (analysis == Analysis::variable_order)
+        t = integrate_variable_order(nominal, rows, fields, progress);
       const double eps = 1e-12 * time.end_time;
       while (t < time.end_time - eps)
         {

@@ -642,3 +642,103 @@ TEST(BoucWenUniaxial, FailuresAreRuntimeErrors)
   double          s[3] = {0, 1, 0}, sigma = 0;
   EXPECT_THROW(law.update(400 * z_y, sigma, s), hysteron::RuntimeError);
 }
+
+
+
+// The time rates (state_rate) are the rate form of update(): the state change of
+// a small increment, divided by it, tends to the rate at eps' = 1 (and the rates
+// scale with eps'). With and without degradation, loading and unloading.
+TEST(BoucWenUniaxial, StateRateIsTheLimitOfSmallIncrements)
+{
+  for (const bool degrading : {false, true})
+    {
+      BoucWenParameters p = parameters(8, BoucWenIntegrator::adaptive, 1e-12, 0.05);
+      p.beta              = 0.75;
+      p.gamma             = 0.25;
+      if (degrading)
+        {
+          p.stiffness_degradation_c_eta = 30;
+          p.stiffness_degradation_m_u   = 0.5;
+          p.strength_deterioration_c_nu = 0.01;
+        }
+      const BoucWenUniaxial law(p, E);
+      const unsigned int    n = law.n_state_variables();
+      for (const double direction : {1.0, -1.0})
+        {
+          const std::array<double, 3> s0{{0.9 * z_y, 1.3, 0.2 * sigma_y * z_y}};
+          std::array<double, 3>       rate{}, rate2{}, s = s0;
+          law.state_rate(s0.data(), direction, rate.data());
+          law.state_rate(s0.data(), 2.5 * direction, rate2.data());
+          const double h     = 1e-6 * z_y;
+          double       sigma = 0;
+          law.update(direction * h, sigma, s.data());
+          const std::array<double, 3> scale{{z_y, 1, sigma_y * z_y}};
+          for (unsigned int i = 0; i < n; ++i)
+            {
+              EXPECT_NEAR((s[i] - s0[i]) / h, rate[i], 1e-5 * scale[i] / z_y)
+                << "component " << i << ", direction " << direction << ", degrading " << degrading;
+              EXPECT_NEAR(rate2[i], 2.5 * rate[i], 1e-12 * scale[i] / z_y);
+            }
+        }
+    }
+}
+
+
+
+// The derivatives of the rates against central differences, away from the
+// sign switch of z eps', for n = 8 and a real n = 2.5, with and without
+// degradation; at eps' = 0 the eps'-derivative of z' is 1 - nu_s H1 beta / eta.
+TEST(BoucWenUniaxial, StateRateDerivativesMatchFiniteDifferences)
+{
+  for (const double n : {8.0, 2.5})
+    for (const bool degrading : {false, true})
+      {
+        BoucWenParameters p = parameters(n, BoucWenIntegrator::adaptive, 1e-6, 0.05);
+        p.beta              = 0.75;
+        p.gamma             = 0.25;
+        if (degrading)
+          {
+            p.stiffness_degradation_c_eta = 30;
+            p.stiffness_degradation_m_u   = 0.5;
+            p.strength_deterioration_c_nu = 0.01;
+          }
+        const BoucWenUniaxial       law(p, E);
+        const unsigned int          m = law.n_state_variables();
+        const std::array<double, 3> scale{{z_y, 1, sigma_y * z_y}};
+        for (const double z : {0.8 * z_y, -0.6 * z_y})
+          for (const double rate : {0.3, -0.7})
+            {
+              const std::array<double, 3> s0{{z, 1.4, 0.3 * sigma_y * z_y}};
+              std::array<double, 9>       J{};
+              std::array<double, 3>       dr{}, fp{}, fm{};
+              law.state_rate_derivatives(s0.data(), rate, J.data(), dr.data());
+              for (unsigned int j = 0; j < m; ++j)
+                {
+                  const double          h  = 1e-6 * scale[j];
+                  std::array<double, 3> sp = s0, sm = s0;
+                  sp[j] += h;
+                  sm[j] -= h;
+                  law.state_rate(sp.data(), rate, fp.data());
+                  law.state_rate(sm.data(), rate, fm.data());
+                  for (unsigned int i = 0; i < m; ++i)
+                    EXPECT_NEAR(J[i * m + j], (fp[i] - fm[i]) / (2 * h),
+                                1e-6 * std::abs(rate) * scale[i] / scale[j] / z_y)
+                      << "d rate " << i << " / d state " << j << ", n = " << n << ", z = " << z
+                      << ", rate = " << rate;
+                }
+              const double h = 1e-6 * std::abs(rate);
+              law.state_rate(s0.data(), rate + h, fp.data());
+              law.state_rate(s0.data(), rate - h, fm.data());
+              for (unsigned int i = 0; i < m; ++i)
+                EXPECT_NEAR(dr[i], (fp[i] - fm[i]) / (2 * h), 1e-6 * scale[i] / z_y)
+                  << "d rate " << i << " / d eps', n = " << n << ", z = " << z;
+            }
+        // eps' = 0: H2 = beta.
+        const std::array<double, 3> s0{{0.8 * z_y, 1.4, 0.3 * sigma_y * z_y}};
+        std::array<double, 9>       J{};
+        std::array<double, 3>       dr{};
+        law.state_rate_derivatives(s0.data(), 0.0, J.data(), dr.data());
+        const double eta = degrading ? s0[1] : 1.0;
+        EXPECT_NEAR(dr[0], (1 - law.nu_s(s0.data()) * law.h1(s0.data()) * 0.75) / eta, 1e-14);
+      }
+}

@@ -226,6 +226,37 @@ namespace hysteron
       }
 
       /**
+       * The time rates of the state for the deformation rate @p deformation_rate
+       * (eps', or delta' of a spring), for an integrator of the state in physical
+       * time (the RBSN's variable-order analysis): @p state_rate receives
+       * n_state_variables() values,
+       *
+       *   z' = eps' (1 - nu_s H1 H2) / eta,  eta' = c_eta eta^(-m_u) |eps' - eta z'|,
+       *   e_h' = (1 - a) k z (eps' - eta z'),
+       *
+       * the right-hand side that update() integrates in pseudo-time (the rates
+       * are homogeneous of degree one in eps'). The Integrator of the parameters
+       * plays no part.
+       */
+      void
+      state_rate(const double *state, const double deformation_rate, double *state_rate) const;
+
+      /**
+       * The derivatives of state_rate(): @p d_state (n x n, row-major,
+       * d rate_i / d state_j) and @p d_deformation_rate (n values, d rate_i / d eps'),
+       * n = n_state_variables(). The rates are smooth except where z eps' changes
+       * sign (H2 jumps; the rates stay continuous because they carry the factor
+       * eps' and H1 = 0 at z = 0): there the derivatives use sgn = 0, H2 = beta,
+       * the mean of the loading and unloading branches, as the tangent of
+       * update() does for deps = 0; likewise d|g|/dg = 0 at g = 0.
+       */
+      void
+      state_rate_derivatives(const double *state,
+                             const double  deformation_rate,
+                             double       *d_state,
+                             double       *d_deformation_rate) const;
+
+      /**
        * Advance one point by the increment @p deps with the integrator of the
        * parameters. @p stress: in, the stress at the start; out, at the end
        * (sigma_{n+1} = sigma_n + a k deps + (1 - a) k (z_{n+1} - z_n)).
@@ -734,6 +765,62 @@ namespace hysteron
       if (tangent)
         *tangent = a * k + k_h * dz_ddeps;
       return work;
+    }
+
+
+
+    inline void
+    BoucWenUniaxial::state_rate(const double *state, const double deformation_rate, double *rate) const
+    {
+      if (degrading)
+        {
+          const Vector<true> f = rates<true>({{state[0], state[1], state[2]}}, deformation_rate);
+          std::copy(f.begin(), f.end(), rate);
+        }
+      else
+        rate[0] = rates<false>({{state[0]}}, deformation_rate)[0];
+    }
+
+
+
+    inline void
+    BoucWenUniaxial::state_rate_derivatives(const double *state,
+                                            const double  deformation_rate,
+                                            double       *d_state,
+                                            double       *d_deformation_rate) const
+    {
+      // With P = H1 H2 eps' and dH1/dz = n H1 / z: dP/dz = n H1 H2 eps' / z and,
+      // H2 held constant, dP/d eps' = H1 H2. The z' row in eps' is rate_tangent().
+      const double z      = state[z_index];
+      const double h1     = abs_pow(z * inv_z_y);
+      const double h2     = beta_plus_gamma_sign(z * deformation_rate);
+      const double dP_dz  = (z != 0 ? n * h1 / z : 0.0) * h2 * deformation_rate;
+      const double dP_der = h1 * h2;
+      if (!degrading)
+        {
+          d_state[0]            = -dP_dz;
+          d_deformation_rate[0] = rate_tangent<false>({{z}}, deformation_rate);
+          return;
+        }
+      // g = nu_s P (nu_s = 1 + c e_h), z' = (eps' - g) / eta, eta' = c_eta eta^(-m_u) |g|,
+      // e_h' = (1 - a) k z g; state order (z, eta, e_h).
+      const double eta = state[eta_index], e = state[energy_index];
+      const double nu = 1 + c_nu_scaled * e, P = h1 * h2 * deformation_rate, g = nu * P;
+      const double dg_dz = nu * dP_dz, dg_de = c_nu_scaled * P, dg_der = nu * dP_der;
+      const double p = c_eta * eta_power(eta), sg = (g > 0 ? 1.0 : (g < 0 ? -1.0 : 0.0));
+      double      *J = d_state;
+      J[0] = -dg_dz / eta;
+      J[1] = -(deformation_rate - g) / (eta * eta);
+      J[2] = -dg_de / eta;
+      J[3] = p * sg * dg_dz;
+      J[4] = -m_u * p / eta * std::abs(g);
+      J[5] = p * sg * dg_de;
+      J[6] = k_h * (g + z * dg_dz);
+      J[7] = 0;
+      J[8] = k_h * z * dg_de;
+      d_deformation_rate[0] = rate_tangent<true>({{z, eta, e}}, deformation_rate);
+      d_deformation_rate[1] = p * sg * dg_der;
+      d_deformation_rate[2] = k_h * z * dg_der;
     }
 
 

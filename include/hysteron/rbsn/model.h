@@ -2,6 +2,7 @@
 #define hysteron_rbsn_model_h
 
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/sparse_direct.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/sparsity_pattern.h>
@@ -9,6 +10,7 @@
 
 #include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>
+#include <hysteron/base/progress.h>
 #include <hysteron/material/bouc_wen_uniaxial.h>
 #include <hysteron/rbsn/tessellation.h>
 #include <hysteron/scene/method.h>
@@ -40,6 +42,16 @@ namespace hysteron
       double cohesion         = 0; ///< c [Pa]: the shear strength at zero normal stress
       double friction         = 0; ///< tan of the friction angle
       unsigned int max_cycles = 1000; ///< breaks within one step before the run stops
+    };
+
+    /// `subsection RBSN/Variable order`: SUNDIALS IDA (variable_order.cc).
+    struct VariableOrderParameters
+    {
+      double       relative_tolerance = 1e-6;
+      double       absolute_tolerance = 0; ///< [m] on the displacements; 0: automatic
+      unsigned int maximum_order      = 5; ///< of the BDF, 1..5
+      double       maximum_step       = 0; ///< [s]; 0: unlimited
+      double       initial_step       = 0; ///< [s]; 0: IDA's estimate
     };
 
     /**
@@ -126,6 +138,18 @@ namespace hysteron
       facet_to_break() const;
       void
       external_forces(const double t, Vector &f) const;
+      /// The increment of a prescribed DoF of @p set from t0 to t1 (Dirichlet conditions).
+      double
+      prescribed_increment(const Dirichlet &set, const unsigned int dof, const double t0, const double t1) const;
+      /// The cell's mass matrix about its nucleus (eq. 3.12), DoFs (u, v, theta).
+      void
+      cell_mass_matrix(const unsigned int c, dealii::FullMatrix<double> &M) const;
+      /// Dynamic analyses: velocities, kinetic energy.
+      bool
+      dynamic() const
+      {
+        return analysis == Analysis::implicit_dynamics || analysis == Analysis::variable_order;
+      }
       /// Initial velocities and accelerations (implicit dynamics).
       void
       initial_state();
@@ -149,6 +173,18 @@ namespace hysteron
       point_values(const unsigned int c, const int e, const dealii::Point<2> &x, double *out) const;
       [[noreturn]] void
       fail(const std::string &what, const double t);
+
+      // Analysis = variable order (variable_order.cc): the DAE in (u, v, s) and IDA.
+      class VariableOrder;
+      static void
+      declare_variable_order_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_variable_order_parameters(dealii::ParameterHandler &prm);
+      /// Integrate from 0 to the end time, writing the tables and fields at the output
+      /// times k @p output_interval; returns the end time.
+      double
+      integrate_variable_order(const double output_interval, PointData::Schedule &rows,
+                               PointData::Schedule &fields, Progress &progress);
 
       // Output.
       std::vector<std::string>
@@ -176,6 +212,7 @@ namespace hysteron
       NewtonParameters              newton;
       double                        hht_alpha = 0, rayleigh_mass = 0, rayleigh_stiffness = 0;
       FractureParameters            fracture;
+      VariableOrderParameters       variable_order;
       bool                          spring_table = false;
 
       // The network: cells (rigid bodies), facets (springs), bodies.
@@ -202,6 +239,7 @@ namespace hysteron
 
       // Bookkeeping.
       PointData::Tables<2>                 tables;
+      /// newton.csv (Newton's iterations), ida.csv with variable order (the integrator's statistics)
       std::unique_ptr<Output::CsvWriter>   newton_table, fracture_table;
       std::unique_ptr<Output::FieldWriter> field_writer;
       double internal_work = 0, external_work = 0, boundary_work = 0;
