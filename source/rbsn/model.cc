@@ -539,6 +539,24 @@ namespace hysteron
 
 
 
+    double
+    Model::prescribed_velocity(const Dirichlet &set, const unsigned int dof, const double t) const
+    {
+      const unsigned int k = dof % 3;
+      if (set.rigid >= 0)
+        return k < 2 ? evaluate_in_time<2>(*scene.body_descriptions()[set.rigid].rigid_velocity, t)[k] : 0.0;
+      const auto &d = scene.boundary_descriptions()[set.boundary];
+      if (d.velocity)
+        return k < 2 ? evaluate_in_time<2>(*d.velocity, t)[k] : 0.0;
+      if (!d.displacement)
+        return 0; // fixed, roller
+      // g'(t) = (g(t + h) - g(t - h)) / 2h, error O(h^2).
+      const double h = 1e-6 * std::max(scene.time_control().end_time, 1e-300);
+      return prescribed_increment(set, dof, t - h, t + h) / (2 * h);
+    }
+
+
+
     void
     Model::cell_mass_matrix(const unsigned int c, dealii::FullMatrix<double> &M) const
     {

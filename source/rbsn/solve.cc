@@ -52,21 +52,10 @@ namespace hysteron
             }
           for (unsigned int k = 0; k < 6; ++k)
             ue[k] = u_trial(dofs[k]);
-          const std::array<const double *, 3> rows{{sp.B_n.data(), sp.B_t.data(), nullptr}};
-          const auto apply = [&](const unsigned int i, const dealii::Vector<double> &x) {
-            if (i == 2)
-              return x[5] - x[2];
-            double s = 0;
-            for (unsigned int k = 0; k < 6; ++k)
-              s += rows[i][k] * x[k];
-            return s;
-          };
-          const auto row = [&](const unsigned int i, const unsigned int k) {
-            return i == 2 ? (k == 5 ? 1.0 : k == 2 ? -1.0 : 0.0) : rows[i][k];
-          };
+          const auto row = [&](const unsigned int i, const unsigned int k) { return sp.B(i, k); };
           for (unsigned int i = 0; i < 3; ++i)
             {
-              sp.trial_delta[i] = apply(i, ue);
+              sp.trial_delta[i] = sp.deformation(i, ue);
               const double increment = sp.trial_delta[i] - sp.delta[i];
               if (!update_springs)
                 {
@@ -169,12 +158,7 @@ namespace hysteron
           const double c_M = 1 / (beta * dt * dt) + (1 + alpha) * gamma / (beta * dt) * rayleigh_mass;
           for (unsigned int c = 0; c < network.cells.size(); ++c)
             {
-              const double m = cell_mass[c], ox = cell_offset[c][0], oy = cell_offset[c][1];
-              M(0, 0) = M(1, 1) = m;
-              M(0, 1) = M(1, 0) = 0;
-              M(0, 2) = M(2, 0) = -m * oy;
-              M(1, 2) = M(2, 1) = m * ox;
-              M(2, 2)           = cell_inertia[c];
+              cell_mass_matrix(c, M);
               for (unsigned int k = 0; k < 3; ++k)
                 {
                   cd[k]       = 3 * c + k;
@@ -397,12 +381,7 @@ namespace hysteron
       std::vector<dealii::types::global_dof_index> cd(3);
       for (unsigned int c = 0; c < network.cells.size(); ++c)
         {
-          const double m = cell_mass[c], ox = cell_offset[c][0], oy = cell_offset[c][1];
-          M       = 0;
-          M(0, 0) = M(1, 1) = m;
-          M(0, 2) = M(2, 0) = -m * oy;
-          M(1, 2) = M(2, 1) = m * ox;
-          M(2, 2)           = cell_inertia[c];
+          cell_mass_matrix(c, M);
           for (unsigned int k = 0; k < 3; ++k)
             cd[k] = 3 * c + k;
           constraints.distribute_local_to_global(M, zero, cd, matrix, rhs);
@@ -419,18 +398,11 @@ namespace hysteron
             const Facet   &f  = network.facets[e];
             const Springs &sp = springs[e];
             const double   U[6] = {v(3 * f.a), v(3 * f.a + 1), v(3 * f.a + 2), v(3 * f.b), v(3 * f.b + 1), v(3 * f.b + 2)};
-            double         dn = 0, dt = 0;
-            for (unsigned int k = 0; k < 6; ++k)
+            for (unsigned int i = 0; i < 3; ++i)
               {
-                dn += sp.B_n[k] * U[k];
-                dt += sp.B_t[k] * U[k];
-              }
-            const double dphi = U[5] - U[2];
-            for (unsigned int k = 0; k < 6; ++k)
-              {
-                const double phi_row = k == 5 ? 1.0 : k == 2 ? -1.0 : 0.0;
-                const double Kv = sp.B_n[k] * sp.k[0] * dn + sp.B_t[k] * sp.k[1] * dt + phi_row * sp.k[2] * dphi;
-                force(k < 3 ? 3 * f.a + k : 3 * f.b + k - 3) -= rayleigh_stiffness * Kv;
+                const double kv = sp.k[i] * sp.deformation(i, U);
+                for (unsigned int k = 0; k < 6; ++k)
+                  force(k < 3 ? 3 * f.a + k : 3 * f.b + k - 3) -= rayleigh_stiffness * sp.B(i, k) * kv;
               }
           }
       for (unsigned int i = 0; i < rhs.size(); ++i)

@@ -69,6 +69,27 @@ namespace hysteron
       double                thickness  = 1;
       bool                  hysteretic = false; ///< Bouc-Wen laws (else linear springs)
       bool                  broken     = false;
+
+      /// B(i, k): row i (n, t, phi) of B, column k of U_e.
+      double
+      B(const unsigned int i, const unsigned int k) const
+      {
+        return i == 0 ? B_n[k] : i == 1 ? B_t[k] : (k == 5 ? 1.0 : k == 2 ? -1.0 : 0.0);
+      }
+
+      /// The deformation (or its rate) B_i U of spring i for the facet's six DoF values @p U.
+      template <typename VectorType>
+      double
+      deformation(const unsigned int i, const VectorType &U) const
+      {
+        if (i == 2)
+          return U[5] - U[2];
+        const auto &row = i == 0 ? B_n : B_t;
+        double      s   = 0;
+        for (unsigned int k = 0; k < 6; ++k)
+          s += row[k] * U[k];
+        return s;
+      }
     };
 
     /// The scene on the network (see Solver). Two-dimensional.
@@ -141,6 +162,10 @@ namespace hysteron
       /// The increment of a prescribed DoF of @p set from t0 to t1 (Dirichlet conditions).
       double
       prescribed_increment(const Dirichlet &set, const unsigned int dof, const double t0, const double t1) const;
+      /// The velocity of a prescribed DoF of @p set at @p t (exact for velocities and rigid
+      /// bodies, a central difference of a prescribed displacement).
+      double
+      prescribed_velocity(const Dirichlet &set, const unsigned int dof, const double t) const;
       /// The cell's mass matrix about its nucleus (eq. 3.12), DoFs (u, v, theta).
       void
       cell_mass_matrix(const unsigned int c, dealii::FullMatrix<double> &M) const;
@@ -150,7 +175,7 @@ namespace hysteron
       {
         return analysis == Analysis::implicit_dynamics || analysis == Analysis::variable_order;
       }
-      /// Initial velocities and accelerations (implicit dynamics).
+      /// Initial velocities and accelerations (dynamics).
       void
       initial_state();
       /// Newton's force level: the last evaluation's, at least 1e-3 of the largest so far

@@ -1,0 +1,670 @@
+#include <deal.II/base/index_set.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/sundials/ida.h>
+
+#include <hysteron/base/parameters.h>
+#include <hysteron/rbsn/model.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+/*
+ * Analysis = variable order: the state-space form of eq. 3.43-3.48 as an
+ * implicit DAE F(t, y, y') = 0 in y = (u, v, s, W), integrated by SUNDIALS IDA
+ * (variable-order, variable-step BDF with local error control) through deal.II's
+ * wrapper. With n = 3 cells DoFs, s the Bouc-Wen states of the hysteretic springs
+ * (z, and eta, e_h with degradation), and W three work quadratures:
+ *
+ *   free DoF i:        u_i' - v_i = 0,
+ *                      (M v' + C v + f_int(u, s) - f_ext(t))_i = 0,
+ *   prescribed DoF i:  u_i' - w_i(t) = 0,   v_i - w_i(t) = 0   (algebraic),
+ *   spring states:     s' - R(s, delta') = 0,   delta' = B v   (the Bouc-Wen rates),
+ *   works:             W_int' = f_int . v,  W_ext' = f_ext . v,  W_bnd' = r . w,
+ *
+ * with M the cell mass matrices (eq. 3.12), C = a0 M + a1 K0 (K0: the elastic
+ * springs, as in the Newmark analysis), f_int = sum_e B^T F, F_i = a k delta_i +
+ * (1 - a) k z_i (linear springs: k delta_i), w the prescribed velocities and r
+ * the reactions f_int + M v' + C v - f_ext on the prescribed DoFs. IDA's Newton
+ * matrix dF/dy + c_j dF/dy' is assembled exactly (the quadratures' rows keep only
+ * c_j: they do not feed back) and factorised by UMFPACK. Fracture is refused at
+ * parse time: a break is a discontinuity of the right-hand side.
+ */
+
+namespace
+{
+  // deal.II 9.4's IDA keeps its SUNDIALS memory private, so it offers neither the
+  // integrator's statistics nor a maximum step. An explicit instantiation may name a
+  // private member (C++17 [temp.spec]/6), which gives the pointer to it.
+  using Ida = dealii::SUNDIALS::IDA<dealii::Vector<double>>;
+
+  struct IdaMemory
+  {
+    using type = void *Ida::*;
+    friend type
+    member(IdaMemory);
+  };
+
+  template <typename Tag, typename Tag::type pointer>
+  struct Expose
+  {
+    friend typename Tag::type
+    member(Tag)
+    {
+      return pointer;
+    }
+  };
+
+  template struct Expose<IdaMemory, &Ida::ida_mem>;
+} // namespace
+
+
+
+namespace hysteron
+{
+  namespace RBSN
+  {
+    void
+    Model::declare_variable_order_parameters(dealii::ParameterHandler &prm)
+    {
+      using namespace dealii;
+      prm.enter_subsection("Variable order");
+      {
+        prm.declare_entry("Relative tolerance",
+                          "1e-6",
+                          Patterns::Double(),
+                          "IDA's relative tolerance of the local error, in (0, 1).");
+        prm.declare_entry("Absolute tolerance",
+                          "0",
+                          Patterns::Double(),
+                          "IDA's absolute tolerance [m] on the displacements, >= 0; 0: the relative "
+                          "tolerance times 1e-3 of the network's size. Rotations and the rotational "
+                          "springs' z get it divided by the network's size, velocities divided by "
+                          "the output interval (Time step), eta the relative tolerance, e_h it times "
+                          "the spring's yield force, the work quadratures 1e-2 k_n atol^2 / rtol (k_n: the "
+                          "stiffest normal spring).");
+        prm.declare_entry("Maximum order", "5", Patterns::Integer(), "Of the BDF, 1..5.");
+        prm.declare_entry("Maximum step", "0", Patterns::Double(), "[s], >= 0; 0: unlimited.");
+        prm.declare_entry("Initial step", "0", Patterns::Double(), "[s], >= 0; 0: IDA's estimate.");
+      }
+      prm.leave_subsection();
+    }
+
+
+
+    void
+    Model::parse_variable_order_parameters(dealii::ParameterHandler &prm)
+    {
+      Section s(prm, {"RBSN", "Variable order"});
+      auto   &p            = variable_order;
+      p.relative_tolerance = s.get_in_open_interval("Relative tolerance", 0, 1);
+      p.absolute_tolerance = s.get_non_negative("Absolute tolerance");
+      const long order     = s.get_integer("Maximum order");
+      require(order >= 1 && order <= 5, s.where("Maximum order"),
+              "must be 1, 2, 3, 4 or 5 (got " + s.get("Maximum order") + ")");
+      p.maximum_order = order;
+      p.maximum_step  = s.get_non_negative("Maximum step");
+      p.initial_step  = s.get_non_negative("Initial step");
+      require(p.maximum_step == 0 || p.initial_step <= p.maximum_step, s.where("Initial step"),
+              "must not exceed the Maximum step (got " + s.get("Initial step") + " > " +
+                s.get("Maximum step") + ")");
+      if (analysis == Analysis::variable_order)
+        require(!fracture.enabled, "RBSN/Fracture/Enabled",
+                "the variable-order analysis has no fracture (a break is a discontinuity of the "
+                "DAE that IDA integrates): use Analysis = implicit dynamics, or switch fracture off");
+    }
+
+
+
+    /// The DAE of the variable-order analysis and its Newton matrix (see the top of the file).
+    class Model::VariableOrder
+    {
+    public:
+      explicit VariableOrder(Model &model);
+
+      /// F(t, y, y'); returns 0, or 1 (recoverable: IDA retries with a smaller step).
+      int
+      residual(const double t, const Vector &y, const Vector &yp, Vector &F);
+      int
+      setup_jacobian(const Vector &y, const double cj);
+      int
+      solve(const Vector &rhs, Vector &x);
+
+      /// The initial y and a consistent y' from the model's initial state.
+      void
+      initial_values(Vector &y, Vector &yp);
+      /// y (and y') into the model's vectors and springs, for its output.
+      void
+      to_model(const double t, const Vector &y, const Vector &yp);
+
+      dealii::IndexSet
+      differential_components() const;
+
+      Vector       tolerances;
+      unsigned int size() const
+      {
+        return n_total;
+      }
+
+    private:
+      Model       &m;
+      unsigned int n = 0, n_states = 0, n_total = 0;
+      /// The first slot in y of the state of spring i of facet e: 3 e + i, -1 if linear.
+      std::vector<int>              state_offset;
+      std::vector<double>           w; ///< prescribed velocities at the last t
+      Vector                        reaction, f_ext;
+      dealii::SparsityPattern       pattern;
+      dealii::SparseMatrix<double>  jacobian;
+      dealii::SparseDirectUMFPACK   direct;
+
+      unsigned int
+      s_index(const unsigned int e, const unsigned int i) const
+      {
+        return 2 * n + state_offset[3 * e + i];
+      }
+      void
+      prescribed_velocities(const double t);
+      /// The facet's six DoF indices.
+      std::array<unsigned int, 6>
+      facet_dofs(const unsigned int e) const
+      {
+        const Facet &f = m.network.facets[e];
+        return {{3 * f.a, 3 * f.a + 1, 3 * f.a + 2, 3 * f.b, 3 * f.b + 1, 3 * f.b + 2}};
+      }
+    };
+
+
+
+    Model::VariableOrder::VariableOrder(Model &model)
+      : m(model)
+      , n(model.u.size())
+    {
+      state_offset.assign(3 * m.springs.size(), -1);
+      for (unsigned int e = 0; e < m.springs.size(); ++e)
+        if (m.springs[e].hysteretic)
+          for (unsigned int i = 0; i < 3; ++i)
+            {
+              state_offset[3 * e + i] = n_states;
+              n_states += m.springs[e].law[i].n_state_variables();
+            }
+      n_total = 2 * n + n_states + 3;
+      w.assign(n, 0.0);
+      reaction.reinit(n);
+      f_ext.reinit(n);
+
+      // The Newton matrix's pattern: kinematic rows (u_i, u_i), (u_i, v_i); the cells'
+      // mass blocks; per facet the (v, u) and (v, v) blocks of its two cells, the
+      // (v, z) columns of its springs, the (s, s) and (s, v) blocks of its springs.
+      dealii::DynamicSparsityPattern dsp(n_total, n_total);
+      for (unsigned int i = 0; i < n; ++i)
+        {
+          dsp.add(i, i);
+          dsp.add(i, n + i);
+        }
+      for (unsigned int c = 0; c < m.network.cells.size(); ++c)
+        for (unsigned int p = 0; p < 3; ++p)
+          for (unsigned int q = 0; q < 3; ++q)
+            dsp.add(n + 3 * c + p, n + 3 * c + q);
+      for (unsigned int e = 0; e < m.springs.size(); ++e)
+        {
+          const auto dofs = facet_dofs(e);
+          for (const unsigned int p : dofs)
+            for (const unsigned int q : dofs)
+              {
+                dsp.add(n + p, q);
+                dsp.add(n + p, n + q);
+              }
+          if (state_offset[3 * e] < 0)
+            continue;
+          for (unsigned int i = 0; i < 3; ++i)
+            {
+              const unsigned int k = m.springs[e].law[i].n_state_variables(), s0 = s_index(e, i);
+              for (const unsigned int p : dofs)
+                dsp.add(n + p, s0);
+              for (unsigned int a = 0; a < k; ++a)
+                {
+                  for (unsigned int b = 0; b < k; ++b)
+                    dsp.add(s0 + a, s0 + b);
+                  for (const unsigned int q : dofs)
+                    dsp.add(s0 + a, n + q);
+                }
+            }
+        }
+      for (unsigned int j = 2 * n + n_states; j < n_total; ++j)
+        dsp.add(j, j);
+      pattern.copy_from(dsp);
+      jacobian.reinit(pattern);
+
+      // Absolute tolerances (see the parameter's documentation).
+      const auto  &p     = m.variable_order;
+      const double atol  = p.absolute_tolerance > 0 ? p.absolute_tolerance : p.relative_tolerance * 1e-3 * m.scale;
+      const double t_out = m.time_step > 0 ? m.time_step :
+                           m.scene.time_control().time_step > 0 ? m.scene.time_control().time_step :
+                                                                  m.scene.time_control().end_time / m.n_increments;
+      tolerances.reinit(n_total);
+      for (unsigned int i = 0; i < n; ++i)
+        {
+          tolerances(i)     = i % 3 == 2 ? atol / m.scale : atol;
+          tolerances(n + i) = tolerances(i) / t_out;
+        }
+      for (unsigned int e = 0; e < m.springs.size(); ++e)
+        if (state_offset[3 * e] >= 0)
+          for (unsigned int i = 0; i < 3; ++i)
+            {
+              const auto        &law = m.springs[e].law[i];
+              const unsigned int s0  = s_index(e, i);
+              tolerances(s0)         = i == 2 ? atol / m.scale : atol;
+              if (law.degradation())
+                {
+                  tolerances(s0 + Material::BoucWenUniaxial::eta_index)    = p.relative_tolerance;
+                  tolerances(s0 + Material::BoucWenUniaxial::energy_index) = tolerances(s0) * law.yield_value();
+                }
+            }
+      // The works: 1e-2 k_max d atol, the work of the largest normal spring's force at
+      // the displacement d = atol / rtol over atol, a hundredth of it (the smooth
+      // quadratures cost few steps).
+      double k_max = 0;
+      for (const auto &sp : m.springs)
+        k_max = std::max(k_max, sp.k[0]);
+      for (unsigned int j = 2 * n + n_states; j < n_total; ++j)
+        tolerances(j) = 1e-2 * k_max * atol * atol / p.relative_tolerance;
+    }
+
+
+
+    dealii::IndexSet
+    Model::VariableOrder::differential_components() const
+    {
+      // All but the velocities of the prescribed DoFs.
+      dealii::IndexSet set(n_total);
+      set.add_range(0, n_total);
+      dealii::IndexSet algebraic(n_total);
+      for (unsigned int i = 0; i < n; ++i)
+        if (m.dof_set[i] >= 0)
+          algebraic.add_index(n + i);
+      set.subtract_set(algebraic);
+      return set;
+    }
+
+
+
+    void
+    Model::VariableOrder::prescribed_velocities(const double t)
+    {
+      for (unsigned int i = 0; i < n; ++i)
+        w[i] = m.dof_set[i] >= 0 ? m.prescribed_velocity(m.dirichlet[m.dof_set[i]], i, t) : 0.0;
+    }
+
+
+
+    int
+    Model::VariableOrder::residual(const double t, const Vector &y, const Vector &yp, Vector &F)
+    {
+      prescribed_velocities(t);
+      m.external_forces(t, f_ext);
+      const double a0 = m.rayleigh_mass, a1 = m.rayleigh_stiffness;
+      F = 0;
+      // Kinematics.
+      for (unsigned int i = 0; i < n; ++i)
+        if (m.dof_set[i] < 0)
+          F(i) = yp(i) - y(n + i);
+        else
+          {
+            F(i)     = yp(i) - w[i];
+            F(n + i) = y(n + i) - w[i];
+          }
+
+      // reaction = M (v' + a0 v) + f_int + a1 K0 v - f_ext on every DoF.
+      reaction = 0;
+      reaction -= f_ext;
+      dealii::FullMatrix<double> M(3, 3);
+      for (unsigned int c = 0; c < m.network.cells.size(); ++c)
+        {
+          m.cell_mass_matrix(c, M);
+          for (unsigned int p = 0; p < 3; ++p)
+            for (unsigned int q = 0; q < 3; ++q)
+              reaction(3 * c + p) += M(p, q) * (yp(n + 3 * c + q) + a0 * y(n + 3 * c + q));
+        }
+      double power_int = 0, power_ext = 0, power_bnd = 0;
+      std::array<double, 6> U, V;
+      for (unsigned int e = 0; e < m.springs.size(); ++e)
+        {
+          const Springs &sp   = m.springs[e];
+          const auto     dofs = facet_dofs(e);
+          for (unsigned int k = 0; k < 6; ++k)
+            {
+              U[k] = y(dofs[k]);
+              V[k] = y(n + dofs[k]);
+            }
+          for (unsigned int i = 0; i < 3; ++i)
+            {
+              const double delta = sp.deformation(i, U), rate = sp.deformation(i, V);
+              double       force = sp.k[i] * delta;
+              if (sp.hysteretic)
+                {
+                  // F = a k delta + (1 - a) k z, and s' = R(s, delta').
+                  const auto        &law = sp.law[i];
+                  const unsigned int s0  = s_index(e, i), k = law.n_state_variables();
+                  double             state[Material::BoucWenUniaxial::max_n_state_variables], R[3];
+                  for (unsigned int j = 0; j < k; ++j)
+                    state[j] = y(s0 + j);
+                  force = law.stress(delta, state);
+                  law.state_rate(state, rate, R);
+                  for (unsigned int j = 0; j < k; ++j)
+                    F(s0 + j) = yp(s0 + j) - R[j];
+                }
+              power_int += force * rate;
+              const double total = force + a1 * sp.k[i] * rate;
+              for (unsigned int k = 0; k < 6; ++k)
+                reaction(dofs[k]) += sp.B(i, k) * total;
+            }
+        }
+      for (unsigned int i = 0; i < n; ++i)
+        {
+          power_ext += f_ext(i) * y(n + i);
+          if (m.dof_set[i] < 0)
+            F(n + i) = reaction(i);
+          else
+            power_bnd += reaction(i) * w[i];
+        }
+      const unsigned int iw = 2 * n + n_states;
+      F(iw)     = yp(iw) - power_int;
+      F(iw + 1) = yp(iw + 1) - power_ext;
+      F(iw + 2) = yp(iw + 2) - power_bnd;
+      return std::isfinite(F.l2_norm()) ? 0 : 1;
+    }
+
+
+
+    int
+    Model::VariableOrder::setup_jacobian(const Vector &y, const double cj)
+    {
+      const double a0 = m.rayleigh_mass, a1 = m.rayleigh_stiffness;
+      jacobian = 0;
+      for (unsigned int i = 0; i < n; ++i)
+        {
+          jacobian.add(i, i, cj);
+          if (m.dof_set[i] < 0)
+            jacobian.add(i, n + i, -1.0);
+          else
+            jacobian.add(n + i, n + i, 1.0);
+        }
+      // The prescribed DoFs' v rows are v_i - w_i(t): only the rows of free DoFs get
+      // the equation of motion's derivatives.
+      const auto free = [&](const unsigned int i) { return m.dof_set[i] < 0; };
+      dealii::FullMatrix<double> M(3, 3);
+      for (unsigned int c = 0; c < m.network.cells.size(); ++c)
+        {
+          m.cell_mass_matrix(c, M);
+          for (unsigned int p = 0; p < 3; ++p)
+            if (free(3 * c + p))
+              for (unsigned int q = 0; q < 3; ++q)
+                jacobian.add(n + 3 * c + p, n + 3 * c + q, (cj + a0) * M(p, q));
+        }
+      std::array<double, 6> U, V;
+      for (unsigned int e = 0; e < m.springs.size(); ++e)
+        {
+          const Springs &sp   = m.springs[e];
+          const auto     dofs = facet_dofs(e);
+          for (unsigned int k = 0; k < 6; ++k)
+            {
+              U[k] = y(dofs[k]);
+              V[k] = y(n + dofs[k]);
+            }
+          for (unsigned int i = 0; i < 3; ++i)
+            {
+              // dF/d delta = a k (the z part is a state of its own), dF/dz = (1 - a) k.
+              const double a  = sp.hysteretic ? sp.law[i].parameters().post_yield_ratio : 1.0;
+              const double ka = a * sp.k[i], kv = a1 * sp.k[i], kz = (1 - a) * sp.k[i];
+              for (unsigned int p = 0; p < 6; ++p)
+                if (free(dofs[p]))
+                  for (unsigned int q = 0; q < 6; ++q)
+                    {
+                      const double BB = sp.B(i, p) * sp.B(i, q);
+                      jacobian.add(n + dofs[p], dofs[q], ka * BB);
+                      if (kv != 0)
+                        jacobian.add(n + dofs[p], n + dofs[q], kv * BB);
+                    }
+              if (!sp.hysteretic)
+                continue;
+              const auto        &law = sp.law[i];
+              const unsigned int s0 = s_index(e, i), k = law.n_state_variables();
+              for (unsigned int p = 0; p < 6; ++p)
+                if (free(dofs[p]))
+                  jacobian.add(n + dofs[p], s0, sp.B(i, p) * kz);
+              // s' - R(s, B_i v): c_j I - dR/ds, and -dR/d delta' B_i in the v columns.
+              double state[3], dR_ds[9], dR_dr[3];
+              for (unsigned int j = 0; j < k; ++j)
+                state[j] = y(s0 + j);
+              law.state_rate_derivatives(state, sp.deformation(i, V), dR_ds, dR_dr);
+              for (unsigned int r = 0; r < k; ++r)
+                {
+                  for (unsigned int j = 0; j < k; ++j)
+                    jacobian.add(s0 + r, s0 + j, (r == j ? cj : 0.0) - dR_ds[r * k + j]);
+                  for (unsigned int q = 0; q < 6; ++q)
+                    if (sp.B(i, q) != 0)
+                      jacobian.add(s0 + r, n + dofs[q], -dR_dr[r] * sp.B(i, q));
+                }
+            }
+        }
+      for (unsigned int j = 2 * n + n_states; j < n_total; ++j)
+        jacobian.add(j, j, cj);
+      try
+        {
+          direct.initialize(jacobian);
+        }
+      catch (const dealii::ExceptionBase &)
+        {
+          return -1; // singular: an unsupported network (IDA stops, run() reports it)
+        }
+      return 0;
+    }
+
+
+
+    int
+    Model::VariableOrder::solve(const Vector &rhs, Vector &x)
+    {
+      direct.vmult(x, rhs);
+      return std::isfinite(x.l2_norm()) ? 0 : 1;
+    }
+
+
+
+    void
+    Model::VariableOrder::initial_values(Vector &y, Vector &yp)
+    {
+      // y(0): the model's initial state, the prescribed velocities w(0); y'(0): the
+      // rates of the residual at y' = 0 (F = y' - rate for u, s and W), the
+      // accelerations of initial_state() (M a = f_ext - f_int - C v on the free DoFs).
+      prescribed_velocities(0);
+      y.reinit(n_total);
+      yp.reinit(n_total);
+      for (unsigned int i = 0; i < n; ++i)
+        {
+          y(i)     = m.u(i);
+          y(n + i) = m.dof_set[i] < 0 ? m.v(i) : w[i];
+        }
+      for (unsigned int e = 0; e < m.springs.size(); ++e)
+        if (state_offset[3 * e] >= 0)
+          for (unsigned int i = 0; i < 3; ++i)
+            for (unsigned int j = 0; j < m.springs[e].law[i].n_state_variables(); ++j)
+              y(s_index(e, i) + j) = m.springs[e].state[3 * i + j];
+      const unsigned int iw = 2 * n + n_states;
+      y(iw)     = m.internal_work;
+      y(iw + 1) = m.external_work;
+      y(iw + 2) = m.boundary_work;
+      Vector F(n_total);
+      residual(0, y, yp, F);
+      for (unsigned int j = 0; j < n_total; ++j)
+        yp(j) = j >= n && j < 2 * n ? (m.dof_set[j - n] < 0 ? m.a(j - n) : 0.0) : -F(j);
+    }
+
+
+
+    void
+    Model::VariableOrder::to_model(const double t, const Vector &y, const Vector &yp)
+    {
+      Vector F(n_total);
+      residual(t, y, yp, F); // reaction = f_int + M v' + C v - f_ext, f_ext at t
+      m.f_ext = f_ext;
+      m.f_int = 0;
+      std::array<double, 6> U;
+      for (unsigned int i = 0; i < n; ++i)
+        {
+          m.u(i) = y(i);
+          m.v(i) = y(n + i);
+          m.a(i) = yp(n + i);
+        }
+      for (unsigned int e = 0; e < m.springs.size(); ++e)
+        {
+          Springs   &sp   = m.springs[e];
+          const auto dofs = facet_dofs(e);
+          for (unsigned int k = 0; k < 6; ++k)
+            U[k] = y(dofs[k]);
+          for (unsigned int i = 0; i < 3; ++i)
+            {
+              sp.delta[i] = sp.deformation(i, U);
+              if (sp.hysteretic)
+                {
+                  for (unsigned int j = 0; j < sp.law[i].n_state_variables(); ++j)
+                    sp.state[3 * i + j] = y(s_index(e, i) + j);
+                  sp.force[i] = sp.law[i].stress(sp.delta[i], sp.state.data() + 3 * i);
+                }
+              else
+                sp.force[i] = sp.k[i] * sp.delta[i];
+              for (unsigned int k = 0; k < 6; ++k)
+                m.f_int(dofs[k]) += sp.B(i, k) * sp.force[i];
+            }
+          sp.trial_delta = sp.delta;
+          sp.trial_force = sp.force;
+          sp.trial_state = sp.state;
+        }
+      // The output's reactions are f_int + inertia - f_ext: inertia = M v' + C v.
+      m.inertia = reaction;
+      m.inertia += f_ext;
+      m.inertia -= m.f_int;
+      m.u_trial = m.u;
+      const unsigned int iw = 2 * n + n_states;
+      m.internal_work       = y(iw);
+      m.external_work       = y(iw + 1);
+      m.boundary_work       = y(iw + 2);
+    }
+
+
+
+    double
+    Model::integrate_variable_order(const double         output_interval,
+                                    PointData::Schedule &rows,
+                                    PointData::Schedule &fields,
+                                    Progress            &progress)
+    {
+      const auto  &p        = variable_order;
+      const double end_time = scene.time_control().end_time;
+      VariableOrder dae(*this);
+
+      using Data = Ida::AdditionalData;
+      Data data(0,
+                end_time,
+                p.initial_step, // IDASetInitStep: 0 lets IDA estimate it
+                output_interval,
+                0,
+                p.maximum_order,
+                10,
+                0,
+                0, // replaced by the local tolerances
+                p.relative_tolerance,
+                true, // the prescribed velocities (algebraic) stay out of the error test
+                Data::none, // y(0), y'(0) are consistent (initial_values())
+                Data::none);
+      Ida ida(data);
+      ida.reinit_vector = [&](Vector &x) { x.reinit(dae.size()); };
+      ida.residual      = [&](const double t, const Vector &y, const Vector &yp, Vector &F) {
+        return dae.residual(t, y, yp, F);
+      };
+      ida.setup_jacobian = [&](const double, const Vector &y, const Vector &, const double cj) {
+        return dae.setup_jacobian(y, cj);
+      };
+      ida.solve_with_jacobian = [&](const Vector &rhs, Vector &x, const double) { return dae.solve(rhs, x); };
+      ida.differential_components = [&]() { return dae.differential_components(); };
+      ida.get_local_tolerances    = [&]() -> Vector & { return dae.tolerances; };
+
+      const double eps      = 1e-12 * end_time;
+      double       last_good = 0;
+      std::string  ida_error;
+      ida.output_step       = [&](const double t, const Vector &y, const Vector &yp, const unsigned int k) {
+        void *mem = ida.*member(IdaMemory());
+        // The output step runs after IDA's (re)initialisation and before each IDASolve.
+        IDASetMaxNumSteps(mem, 1000000);
+        // IDA's messages: errors are kept for the failure report below; warnings are
+        // dropped (its linear-solver monitor counts one 'iteration' per direct solve and
+        // warns about convergence failure rates within short output intervals).
+        IDASetErrHandlerFn(
+          mem,
+          [](int code, const char *, const char *function, char *message, void *data) {
+            if (code < 0)
+              *static_cast<std::string *>(data) = std::string(function) + ": " + message;
+          },
+          &ida_error);
+        if (p.maximum_step > 0)
+          IDASetMaxStep(mem, p.maximum_step);
+        if (k == 0)
+          return; // t = 0 is written by run()
+        // IDASolve returns at the output time unless it failed (the wrapper does not
+        // check its status in a release build).
+        const double expected = std::min(k * output_interval, end_time);
+        long     steps = 0, residuals = 0, setups = 0, iterations = 0, error_fails = 0, convergence_fails = 0;
+        int      order = 0;
+        double   h     = 0;
+        IDAGetNumSteps(mem, &steps);
+        IDAGetLastOrder(mem, &order);
+        IDAGetLastStep(mem, &h);
+        IDAGetNumResEvals(mem, &residuals);
+        IDAGetNumLinSolvSetups(mem, &setups);
+        IDAGetNumNonlinSolvIters(mem, &iterations);
+        IDAGetNumErrTestFails(mem, &error_fails);
+        IDAGetNumNonlinSolvConvFails(mem, &convergence_fails);
+        n_steps  = steps;
+        n_newton = iterations;
+        if (std::abs(t - expected) > eps)
+          {
+            double t_reached = 0;
+            IDAGetCurrentTime(mem, &t_reached);
+            std::ostringstream s;
+            s << "rbsn: IDA did not reach t = " << expected << " s (it stopped at t = " << t_reached
+              << " s with the step " << h << " s after " << steps << " steps, " << error_fails
+              << " error test and " << convergence_fails << " convergence failures): a stiff or "
+              << "non-smooth response beyond the tolerances, an unsupported network, or too many "
+              << "steps (1e6 per output interval).";
+            if (!ida_error.empty())
+              s << " IDA: " << ida_error;
+            fail(s.str(), last_good);
+          }
+        // The wrapper's output times accumulate round-off (t is k output_interval within
+        // eps): the tables get the nominal time, and a last interval of round-off length
+        // is not written again.
+        if (expected - last_good < eps)
+          return;
+        dae.to_model(expected, y, yp);
+        last_good = expected;
+        if (newton_table)
+          newton_table->add_row({expected, double(steps), double(order), h, double(residuals), double(setups),
+                                 double(iterations), double(error_fails), double(convergence_fails)});
+        const bool last = !(expected < end_time - eps);
+        if (rows.due(expected, last))
+          write_table_rows(expected);
+        if (fields.due(expected, last))
+          write_fields(expected);
+        progress.update(n_steps, expected);
+      };
+
+      Vector y, yp;
+      dae.initial_values(y, yp);
+      {
+        dealii::TimerOutput::Scope timing(scene.timer(), "steps");
+        ida.solve_dae(y, yp);
+      }
+      return end_time;
+    }
+  } // namespace RBSN
+} // namespace hysteron
