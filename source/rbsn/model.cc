@@ -93,7 +93,7 @@ namespace hysteron
                           "system of eq. 3.43-3.48 (displacements, velocities and the springs' "
                           "Bouc-Wen states) integrated by SUNDIALS IDA, variable-order (1-5) "
                           "variable-step BDF with error control (subsection Variable order; the "
-                          "Bouc-Wen Integrator is not used; no fracture).");
+                          "Bouc-Wen Integrator is not used; fracture is refused).");
         prm.declare_entry("Time step",
                           "0",
                           Patterns::Double(),

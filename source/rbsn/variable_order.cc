@@ -125,8 +125,10 @@ namespace hysteron
       /// F(t, y, y'); returns 0, or 1 (recoverable: IDA retries with a smaller step).
       int
       residual(const double t, const Vector &y, const Vector &yp, Vector &F);
+      /// Assemble dF/dy + cj dF/dy' at y (it does not depend on t and y') and factorise it.
       int
       setup_jacobian(const Vector &y, const double cj);
+      /// x = J^-1 rhs with the factorisation of the last setup_jacobian().
       int
       solve(const Vector &rhs, Vector &x);
 
@@ -149,7 +151,7 @@ namespace hysteron
     private:
       Model       &m;
       unsigned int n = 0, n_states = 0, n_total = 0;
-      /// The first slot in y of the state of spring i of facet e: 3 e + i, -1 if linear.
+      /// Per spring (index 3 e + i): the offset of its Bouc-Wen state within s, -1 if linear.
       std::vector<int>              state_offset;
       std::vector<double>           w; ///< prescribed velocities at the last t
       Vector                        reaction, f_ext;
@@ -568,11 +570,11 @@ namespace hysteron
                 end_time,
                 p.initial_step, // IDASetInitStep: 0 lets IDA estimate it
                 output_interval,
-                0,
+                0, // minimum step: unused by the 9.4 wrapper
                 p.maximum_order,
-                10,
-                0,
-                0, // replaced by the local tolerances
+                10, // Newton iterations per step (IDA's default is 4)
+                0,  // the linear solver's tolerance factor: IDA's default (a direct solver)
+                0,  // absolute tolerance: replaced by the local tolerances
                 p.relative_tolerance,
                 true, // the prescribed velocities (algebraic) stay out of the error test
                 Data::none, // y(0), y'(0) are consistent (initial_values())
