@@ -231,6 +231,9 @@ def main():
            "it numerically at large steps, Newmark keeps it): below about 3e-5 (u_x) the errors measure this "
            "vibration, and IDA's steps grow sharply from rtol 1e-7, where it starts to resolve it. With 5 % "
            "damping at that frequency the solution is unique and both methods converge to the reference.",
+           "- At some tolerances (damped: 1e-6, 1e-8) IDA fails many error tests and sets up its Jacobian "
+           "at most steps (see the columns): the yield transitions of n = 8 switch z' sharply, and its step "
+           "and order selection oscillates there; the cost stays far below Newmark's for the same error.",
            "- One cell pair: 6 DoFs (IDA: 12 + 3 spring states + 3 work quadratures), so the sparse "
            "direct solves cost little and the run times measure the per-step work of each integrator.", ""]
     (out / f"{name}.md").write_text("\n".join(md))
