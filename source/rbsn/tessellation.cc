@@ -279,7 +279,9 @@ namespace hysteron
     {
       const auto   box   = domain.bounding_box().get_boundary_points();
       const double scale = box.first.distance(box.second);
-      const auto   loops = chain(oriented_boundary({domain}, boundary_h, scale), 1e-9 * scale);
+      // The boundary of the polygonized domain (the one the cells are clipped to): a
+      // chord of a curved boundary lies inside the exact curve, on neither side of it.
+      const auto loops = chain(oriented_boundary({domain.polygonized(boundary_h)}, boundary_h, scale), 1e-9 * scale);
       std::vector<Point> points;
       for (const auto &loop : loops)
         {
@@ -436,10 +438,27 @@ namespace hysteron
                       out.push_back(p + fp / (fp - fq) * (q - p));
                       out_tag.push_back(fp < 0 ? static_cast<int>(j) : tag[k]);
                     }
+                  else if (fp == 0 && fq > 0)
+                    out_tag.back() = j; // p on the bisector: the edge from p runs along it
                 }
               poly.swap(out);
               tag.swap(out_tag);
             }
+          // Drop repeated vertices (a bisector through a vertex, as for cocircular
+          // nuclei): a zero-length edge has no direction, and the inside tests below
+          // need one for every edge. The edge that follows keeps its tag.
+          {
+            std::vector<Point> kept;
+            std::vector<int>   kept_tag;
+            for (unsigned int k = 0; k < poly.size(); ++k)
+              if (poly[k].distance(poly[(k + 1) % poly.size()]) >= 1e-14 * scale)
+                {
+                  kept.push_back(poly[k]);
+                  kept_tag.push_back(tag[k]);
+                }
+            poly.swap(kept);
+            tag.swap(kept_tag);
+          }
 
           // The boundary of cell and domain: the cell's edges inside the domain,
           // and the domain's boundary inside the cell.
@@ -449,8 +468,6 @@ namespace hysteron
           for (unsigned int k = 0; k < m; ++k)
             {
               const Point &p = poly[k], &q = poly[(k + 1) % m];
-              if (p.distance(q) < 1e-14 * scale)
-                continue;
               std::vector<double> cuts{0.0, 1.0};
               for (const auto &s : boundary)
                 {

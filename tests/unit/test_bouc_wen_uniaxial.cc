@@ -642,3 +642,24 @@ TEST(BoucWenUniaxial, FailuresAreRuntimeErrors)
   double          s[3] = {0, 1, 0}, sigma = 0;
   EXPECT_THROW(law.update(400 * z_y, sigma, s), hysteron::RuntimeError);
 }
+
+
+
+// Increments below the round-off of z (a Newton correction of a converged state:
+// 1e-17 z_y and less) leave z unchanged in every integrator, from z of either sign
+// and with either sign of the increment; backward Euler once found no bracket here.
+TEST(BoucWenUniaxial, IncrementsBelowRoundOff)
+{
+  for (const auto integrator : all_integrators)
+    for (const double z0 : {-0.0529, 0.37, -0.999})
+      for (const double deps : {2.6e-18, -2.6e-18, 1e-30, -1e-30})
+        {
+          BoucWenUniaxial law(parameters(8, integrator), E);
+          double          s[3] = {z0 * z_y, 1, 0}, sigma = law.stress(0, s), tangent = 0;
+          ASSERT_NO_THROW(law.update(deps * z_y, sigma, s, &tangent))
+            << "z0 = " << z0 << " z_y, deps = " << deps << " z_y";
+          EXPECT_NEAR(s[0] / z_y, z0, 1e-15);
+          EXPECT_GT(tangent, 0);
+          EXPECT_LE(tangent, E * (1 + 1e-12));
+        }
+}

@@ -572,6 +572,11 @@ namespace hysteron
       // The bracket [lo, hi] with rho(lo) < 0 <= rho(hi), and the residual at hi.
       double   lo = z0, hi = z0;
       Residual res = rho(z0);
+      // An increment below the round-off of z (|r(z_n)| at that level: a Newton
+      // correction of a converged state) leaves z_n, which is then the root.
+      const double round_off = 8 * std::numeric_limits<double>::epsilon() * (std::abs(z0) + z_y);
+      if (std::abs(res.r) <= round_off)
+        res.r = 0;
       if (res.r < 0)
         {
           // z_n is inside the saturation value: the root lies in the direction
@@ -588,7 +593,7 @@ namespace hysteron
             {
               if (e == 60 || std::isnan(res.r))
                 throw_no_convergence(deps, z0, res.r, "found no bracket of the root");
-              hi  = z0 + 2 * (std::max(std::abs(hi - z0), std::abs(predictor - z0)) * sign);
+              hi  = z0 + 2 * (std::max({std::abs(hi - z0), std::abs(predictor - z0), round_off}) * sign);
               res = rho(hi);
             }
         }
