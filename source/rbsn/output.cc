@@ -55,6 +55,15 @@ namespace hysteron
       probe_facet.clear();
       for (const auto &p : scene.output_control().probe_points)
         {
+          // A probe outside every body would silently report its nearest cell.
+          const double tolerance = 1e-6 * d_m;
+          if (std::none_of(body_shapes.begin(), body_shapes.end(),
+                           [&](const auto *shape) { return shape->contains(p, tolerance); }))
+            {
+              std::ostringstream what;
+              what << "the point (" << p << ") lies outside the bodies of the network";
+              throw InputError("Output/Probe points", what.str());
+            }
           unsigned int best = 0;
           for (unsigned int c = 1; c < network.cells.size(); ++c)
             if (network.cells[c].nucleus.distance(p) < network.cells[best].nucleus.distance(p))

@@ -523,6 +523,7 @@ namespace hysteron
       PointData::Schedule fields(scene.output_control().interval, time.end_time);
       Progress progress(scene.console(), "rbsn", time.end_time, scene.output_control().progress_interval);
       const double eps = 1e-12 * time.end_time;
+      unsigned int broken_at_t = n_broken; // facets broken up to the converged state t
       while (t < time.end_time - eps)
         {
           const double dt = increments.step(t, time.end_time);
@@ -577,6 +578,9 @@ namespace hysteron
                   m << "rbsn: Newton did not converge in the increment from t = " << t << " s to "
                     << t + dt << " s after " << newton.max_cuts << " cuts: the structure may have "
                     << "reached its limit load (use displacement control)";
+                  if (n_broken > broken_at_t)
+                    m << "; " << n_broken - broken_at_t << " facets broke in this increment, the "
+                      << "network may have fallen apart";
                   if (!spring_failure.empty())
                     m << "; the last failure was in a spring: " << spring_failure;
                   m << ".";
@@ -585,6 +589,7 @@ namespace hysteron
               continue;
             }
           commit(t + dt, dt);
+          broken_at_t = n_broken;
           increments.accept(t, dt);
           n_cuts = increments.cuts();
           ++n_steps;

@@ -184,7 +184,24 @@ namespace hysteron
   Scene<dim>::Scene(dealii::ParameterHandler &prm, const RunOptions &options)
     : options(options)
     , pcout(std::cout, !options.quiet && dealii::Utilities::MPI::this_mpi_process(options.comm) == 0)
-    , computing_timer(options.comm, pcout, dealii::TimerOutput::never, dealii::TimerOutput::wall_times)
+  {
+    computing_timer.emplace(options.comm, pcout, dealii::TimerOutput::never, dealii::TimerOutput::wall_times);
+    try
+      {
+        parse(prm);
+      }
+    catch (...)
+      {
+        computing_timer.reset();
+        throw;
+      }
+  }
+
+
+
+  template <int dim>
+  void
+  Scene<dim>::parse(dealii::ParameterHandler &prm)
   {
     method_name = prm.get("Method");
     seed        = prm.get_integer("Random seed");
@@ -313,7 +330,7 @@ namespace hysteron
     if (!s.empty())
       pcout << " (" << s << ")";
     pcout << ".\nResults are in " << output.directory << "/" << std::endl;
-    computing_timer.print_summary();
+    computing_timer->print_summary();
   }
 
   namespace Methods

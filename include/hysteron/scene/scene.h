@@ -13,6 +13,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -177,13 +178,19 @@ namespace hysteron
     dealii::TimerOutput &
     timer() const
     {
-      return computing_timer;
+      return *computing_timer;
     }
 
   private:
+    /// The constructor's work: parse the scene and create the method.
+    void
+    parse(dealii::ParameterHandler &prm);
+
     RunOptions                                                      options;
     mutable dealii::ConditionalOStream                              pcout;
-    mutable dealii::TimerOutput                                     computing_timer;
+    /// Created first and destroyed while a parse error is still caught: a
+    /// TimerOutput destroyed during stack unwinding prints a warning.
+    mutable std::optional<dealii::TimerOutput>                      computing_timer;
     std::string                                                     method_name;
     std::map<std::string, std::unique_ptr<Material::Interface<dim>>> materials;
     std::vector<BodyDescription<dim>>                               bodies;
