@@ -83,6 +83,17 @@ namespace hysteron
                           "The rotational spring yields at M_y = factor sigma_y t l^2 (0.25: the "
                           "plastic moment of the facet's section), > 0. The normal and tangential "
                           "springs yield at sigma_y t l and sigma_y t l / sqrt(3).");
+        prm.declare_entry("Spring law",
+                          "uncoupled",
+                          Patterns::Selection("uncoupled|coupled"),
+                          "The facet springs' Bouc-Wen law: 'uncoupled', three uniaxial laws "
+                          "(eq. 3.36), each yielding at its own F_y; 'coupled', one law for the "
+                          "three springs with the yield criterion (F^h_n / F^h_y,n)^2 + (F^h_t / "
+                          "F^h_y,t)^2 + (M^h / M^h_y)^2 <= 1 in the hysteretic forces F^h = (1 - a) "
+                          "k z and associated flow (eq. 3.38-3.42; F^h_y = (1 - a) F_y), a full 3 x "
+                          "3 facet tangent; it reduces to the uniaxial law when one component is "
+                          "loaded alone. No degradation with 'coupled'. See "
+                          "doc/rbsn_coupled_springs.md.");
         prm.declare_entry("Analysis",
                           "quasi-static",
                           Patterns::Selection("static|quasi-static|implicit dynamics|variable order"),
@@ -105,7 +116,8 @@ namespace hysteron
                           "false",
                           Patterns::Bool(),
                           "Write springs.csv at the end: every facet (cells, midpoint, length, "
-                          "distance, stiffnesses, forces, H1 of the three springs, broken).");
+                          "distance, stiffnesses, forces, H1 of the three springs (Spring law = "
+                          "coupled: the facet's Phi^n in all three), broken).");
         prm.enter_subsection("Newton");
         NewtonParameters::declare_parameters(prm);
         prm.leave_subsection();
@@ -159,6 +171,7 @@ namespace hysteron
           boundary_h = 0.25 * d_m;
         shear_ratio  = s.get_non_negative("Shear stiffness ratio");
         moment_yield = s.get_positive("Moment yield factor");
+        spring_law   = s.get("Spring law") == "coupled" ? SpringLaw::coupled : SpringLaw::uncoupled;
         const std::string type = s.get("Analysis");
         analysis = type == "static"            ? Analysis::linear_static :
                    type == "quasi-static"      ? Analysis::quasi_static :
@@ -210,6 +223,12 @@ namespace hysteron
                     "the rbsn method's springs follow the uniaxial Bouc-Wen law: the body's "
                     "material must be 'bouc-wen' or 'linear elastic'");
             consistent_tangent = consistent_tangent && m.has_consistent_tangent();
+            if (bouc_wen && spring_law == SpringLaw::coupled)
+              {
+                const std::string why = Material::BoucWenInteraction::unsupported(
+                  dynamic_cast<const Material::BoucWen<2> &>(m).get_parameters());
+                require(why.empty(), "RBSN/Spring law", why + " (body " + bodies[b].name + ")");
+              }
             require(bodies[b].initial_velocity == nullptr || dynamic(),
                     "Body " + bodies[b].name + "/Initial velocity",
                     "only dynamic analyses have velocities");
@@ -334,8 +353,17 @@ namespace hysteron
                   sp.law[i].initialize_state(sp.state.data() + 3 * i);
                 }
               sp.hysteretic = true;
+              if (spring_law == SpringLaw::coupled)
+                {
+                  // One law for the three springs (eq. 3.38-3.42), z_i in the slots state[3 i].
+                  sp.coupled = true;
+                  sp.coupled_law.reinit(prm, sp.k, sp.yield);
+                  sp.coupled_law.initialize_state(sp.state.data(), 3);
+                }
             }
           sp.tangent     = sp.k; // the first predictor's
+          for (unsigned int i = 0; i < 3; ++i)
+            sp.tangent_matrix[i][i] = sp.k[i];
           sp.trial_state = sp.state;
         }
     }

@@ -39,7 +39,7 @@ namespace hysteron
       out[11] = sp.force[0] / area;
       out[12] = sp.force[1] / area;
       for (unsigned int i = 0; i < 3; ++i)
-        out[13 + i] = sp.hysteretic && !sp.broken ? sp.law[i].h1(sp.state.data() + 3 * i) : 0.0;
+        out[13 + i] = sp.h1(i); // the coupled law: Phi^n of the facet in all three
       out[16] = sp.broken ? 1.0 : 0.0;
     }
 
@@ -203,7 +203,7 @@ namespace hysteron
       for (unsigned int e = 0; e < springs.size(); ++e)
         if (springs[e].hysteretic && !springs[e].broken)
           for (const unsigned int c : {network.facets[e].a, network.facets[e].b})
-            cell_h1[c] = std::max(cell_h1[c], springs[e].law[0].h1(springs[e].state.data()));
+            cell_h1[c] = std::max(cell_h1[c], springs[e].h1(0));
       for (unsigned int c = 0; c < network.cells.size(); ++c)
         for (const auto &loop : network.cells[c].outline)
           {
@@ -315,7 +315,7 @@ namespace hysteron
                                   sp.k[2], sp.delta[0], sp.delta[1],
                                   sp.delta[2], sp.force[0], sp.force[1], sp.force[2]};
           for (unsigned int i = 0; i < 3; ++i)
-            row.push_back(sp.hysteretic && !sp.broken ? sp.law[i].h1(sp.state.data() + 3 * i) : 0.0);
+            row.push_back(sp.h1(i));
           row.push_back(sp.broken ? 1 : 0);
           out.add_row(row);
         }

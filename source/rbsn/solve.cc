@@ -16,7 +16,8 @@ namespace hysteron
      * theta_a, u_b, v_b, theta_b), the springs' deformations are
      * delta = (B_n U_e, B_t U_e, theta_b - theta_a) and their forces F_i(delta_i)
      * (linear, or the uniaxial Bouc-Wen law from the converged state, eq. 3.32);
-     *   f_int = sum_e B^T F,   K = sum_e B^T diag(dF_i / d delta_i) B    (eq. 3.10, 3.31).
+     *   f_int = sum_e B^T F,   K = sum_e B^T diag(dF_i / d delta_i) B    (eq. 3.10, 3.31),
+     * or with the coupled law (eq. 3.38-3.42) K = sum_e B^T D_t B, D_t = dF / d delta (3 x 3).
      * Quasi-static: r = f_int(u) - f_ext(t). Dynamics (HHT-alpha, Newmark for
      * alpha = 0, as the FEM): with the cell mass matrices M_c of eq. 3.12 and
      * C = a0 M + a1 K0 (K0: the elastic springs),
@@ -68,6 +69,8 @@ namespace hysteron
                   sp.tangent[i]     = sp.k[i];
                   continue;
                 }
+              if (sp.coupled)
+                continue; // the three springs together, below
               sp.trial_force[i] = sp.force[i];
               std::copy(sp.state.begin() + 3 * i, sp.state.begin() + 3 * i + 3, sp.trial_state.begin() + 3 * i);
               try
@@ -84,6 +87,30 @@ namespace hysteron
                   message = m.str();
                 }
             }
+          if (sp.coupled && update_springs)
+            {
+              // The coupled law (eq. 3.38-3.42): one update of the facet, a full 3 x 3 D_t.
+              Material::BoucWenInteraction::Vector increment;
+              for (unsigned int i = 0; i < 3; ++i)
+                {
+                  increment[i]          = sp.trial_delta[i] - sp.delta[i];
+                  sp.trial_force[i]     = sp.force[i];
+                  sp.trial_state[3 * i] = sp.state[3 * i];
+                }
+              try
+                {
+                  sp.coupled_law.update(increment, sp.trial_force, sp.trial_state.data(),
+                                        with_matrix ? &sp.tangent_matrix : nullptr, 3);
+                }
+              catch (const RuntimeError &error)
+                {
+                  failed = true;
+                  std::ostringstream m;
+                  m << error.what() << " (the coupled springs of the facet at " << f.midpoint
+                    << ", step to t = " << t1 << " s)";
+                  message = m.str();
+                }
+            }
           if (failed)
             continue;
           for (unsigned int k = 0; k < 6; ++k)
@@ -92,13 +119,23 @@ namespace hysteron
               for (unsigned int i = 0; i < 3; ++i)
                 fe[k] += row(i, k) * sp.trial_force[i];
             }
-          if (with_matrix)
+          if (with_matrix && !sp.coupled)
             for (unsigned int p = 0; p < 6; ++p)
               for (unsigned int q = 0; q < 6; ++q)
                 {
                   K(p, q) = 0;
                   for (unsigned int i = 0; i < 3; ++i)
                     K(p, q) += row(i, p) * sp.tangent[i] * row(i, q);
+                }
+          else if (with_matrix)
+            for (unsigned int p = 0; p < 6; ++p)
+              for (unsigned int q = 0; q < 6; ++q)
+                {
+                  // B^T D_t B with the full (not necessarily symmetric) D_t.
+                  K(p, q) = 0;
+                  for (unsigned int i = 0; i < 3; ++i)
+                    for (unsigned int j = 0; j < 3; ++j)
+                      K(p, q) += row(i, p) * sp.tangent_matrix[i][j] * row(j, q);
                 }
           r = fe;
           if (dynamic)
@@ -370,9 +407,12 @@ namespace hysteron
           v(3 * c)     = w[0];
           v(3 * c + 1) = w[1];
         }
+      // Prescribed DoFs start with the velocity of their condition: with v = 0 under
+      // a moving condition the Newmark recursion a1 = 4 (du - dt v0) / dt^2 - a0 on
+      // that DoF alternates with a growing amplitude, and its inertia enters the reaction.
       for (unsigned int i = 0; i < v.size(); ++i)
         if (dof_set[i] >= 0)
-          v(i) = 0;
+          v(i) = prescribed_velocity(dirichlet[dof_set[i]], i, 0);
       make_constraints(0, 0, false);
       matrix = 0;
       rhs    = 0;
@@ -410,6 +450,11 @@ namespace hysteron
           rhs(i) = force(i);
       solve_linear(a);
       constraints.distribute(a);
+      // ... and its acceleration, g''(0) by a difference of the velocities.
+      const double h = 1e-4 * scene.time_control().end_time;
+      for (unsigned int i = 0; i < a.size(); ++i)
+        if (dof_set[i] >= 0)
+          a(i) = (prescribed_velocity(dirichlet[dof_set[i]], i, h) - v(i)) / h;
     }
 
 

@@ -112,6 +112,10 @@ namespace hysteron
         require(!fracture.enabled, "RBSN/Fracture/Enabled",
                 "the variable-order analysis has no fracture (a break is a discontinuity of the "
                 "DAE that IDA integrates): use Analysis = implicit dynamics, or switch fracture off");
+      if (analysis == Analysis::variable_order)
+        require(spring_law == SpringLaw::uncoupled, "RBSN/Spring law",
+                "the variable-order analysis integrates the uncoupled springs' rates; use "
+                "Analysis = implicit dynamics with the coupled law");
     }
 
 

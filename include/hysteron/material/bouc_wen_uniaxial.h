@@ -1,6 +1,7 @@
 #ifndef hysteron_material_bouc_wen_uniaxial_h
 #define hysteron_material_bouc_wen_uniaxial_h
 
+#include <hysteron/material/bogacki_shampine.h>
 #include <hysteron/material/bouc_wen_parameters.h>
 #include <hysteron/material/integer_power.h>
 
@@ -545,74 +546,36 @@ namespace hysteron
     inline unsigned int
     BoucWenUniaxial::integrate_adaptive(Vector<degrading_> &v, const double deps) const
     {
-      using V                  = Vector<degrading_>;
-      constexpr unsigned int N = degrading_ ? 3 : 1;
+      using V = Vector<degrading_>;
       // Error scales: z by z_y, eta absolutely, e_h by y z_y.
-      const std::array<double, 3> inv_scale{
-        {inv_z_y / tolerance, 1 / tolerance, 1 / (energy_scale * tolerance)}};
-
-      double       s = 0, h = 1;
-      unsigned int accepted = 0;
-      V            k1       = rates<degrading_>(v, deps);
-      for (unsigned int attempt = 0;; ++attempt)
+      V inv_scale;
+      inv_scale[0] = inv_z_y / tolerance;
+      if constexpr (degrading_)
         {
-          if (attempt == max_substeps)
-            throw_too_many_substeps(deps, v[0]);
-          const bool last = (h >= 1 - s);
-          if (last)
-            h = 1 - s;
-
-          V y2, y3, y4;
-          for (unsigned int i = 0; i < N; ++i)
-            y2[i] = v[i] + 0.5 * h * k1[i];
-          const V k2 = rates<degrading_>(y2, deps);
-          for (unsigned int i = 0; i < N; ++i)
-            y3[i] = v[i] + 0.75 * h * k2[i];
-          const V k3 = rates<degrading_>(y3, deps);
-          for (unsigned int i = 0; i < N; ++i)
-            y4[i] = v[i] + h * (2. / 9. * k1[i] + 1. / 3. * k2[i] + 4. / 9. * k3[i]);
-          const V k4 = rates<degrading_>(y4, deps);
-
-          // Difference of the third- and the embedded second-order solution.
-          double err = 0;
-          for (unsigned int i = 0; i < N; ++i)
-            {
-              const double e = std::abs(h * (-5. / 72. * k1[i] + 1. / 12. * k2[i] +
-                                             1. / 9. * k3[i] - 1. / 8. * k4[i])) *
-                               inv_scale[i];
-              if (!(e <= err)) // also catches NaN
-                err = e;
-            }
-          if (!std::isfinite(err))
-            err = 1e10; // overflow of |z/z_y|^n in a trial stage: shrink the step
-
-          if (err <= 1)
-            {
-              v  = y4;
-              k1 = k4;
-              // The exact solution never leaves |z| <= z_s = z_y (beta + gamma)^(-1/n)
-              // while nu_s >= 1 (there z' points inwards or vanishes), so projecting
-              // onto that set can only reduce the error. It removes the overshoot
-              // of the saturation value for large n, and a saturated point then
-              // has z' = 0 exactly and takes a whole increment in one step.
-              if (std::abs(v[0]) > z_saturation)
-                {
-                  bool project = true;
-                  if constexpr (degrading_)
-                    project = (c_nu_scaled * v[2] >= 0);
-                  if (project)
-                    {
-                      v[0] = std::copysign(z_saturation, v[0]);
-                      k1   = rates<degrading_>(v, deps);
-                    }
-                }
-              ++accepted;
-              if (last)
-                return accepted;
-              s += h;
-            }
-          h *= (err == 0 ? 5.0 : std::min(5.0, std::max(0.2, 0.9 / std::cbrt(err))));
+          inv_scale[1] = 1 / tolerance;
+          inv_scale[2] = 1 / (energy_scale * tolerance);
         }
+      // The exact solution never leaves |z| <= z_s = z_y (beta + gamma)^(-1/n) while
+      // nu_s >= 1 (there z' points inwards or vanishes), so projecting onto that set can
+      // only reduce the error. It removes the overshoot of the saturation value for large
+      // n, and a saturated point then has z' = 0 exactly and takes a whole increment in
+      // one step.
+      const auto project = [&](V &w) {
+        if (!(std::abs(w[0]) > z_saturation))
+          return false;
+        if constexpr (degrading_)
+          if (!(c_nu_scaled * w[2] >= 0))
+            return false;
+        w[0] = std::copysign(z_saturation, w[0]);
+        return true;
+      };
+      return bogacki_shampine_32(
+        v,
+        inv_scale,
+        max_substeps,
+        [&](const V &w) { return rates<degrading_>(w, deps); },
+        project,
+        [&]() { throw_too_many_substeps(deps, v[0]); });
     }
 
 

@@ -11,6 +11,7 @@
 #include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>
 #include <hysteron/base/progress.h>
+#include <hysteron/material/bouc_wen_interaction.h>
 #include <hysteron/material/bouc_wen_uniaxial.h>
 #include <hysteron/rbsn/tessellation.h>
 #include <hysteron/scene/method.h>
@@ -54,10 +55,21 @@ namespace hysteron
       double       initial_step       = 0; ///< [s]; 0: IDA's estimate
     };
 
+    /// The facet springs' Bouc-Wen law: three uniaxial laws (eq. 3.36) or one coupled
+    /// law with a yield criterion in the spring forces (eq. 3.38-3.42).
+    enum class SpringLaw
+    {
+      uncoupled,
+      coupled
+    };
+
     /**
      * One facet's three springs (normal, tangential, rotational): stiffness,
      * yield value, the uniaxial Bouc-Wen laws and their converged and trial
      * state. Deformations delta = (delta_n, delta_t, phi) = B [u_a; u_b].
+     * With the coupled law, `coupled_law` replaces the three uniaxial laws; its
+     * state z_i is kept in the slot of spring i (state[3 i]), and D_t (3 x 3) replaces
+     * the diagonal `tangent`.
      */
     struct Springs
     {
@@ -89,6 +101,20 @@ namespace hysteron
         for (unsigned int k = 0; k < 6; ++k)
           s += row[k] * U[k];
         return s;
+      }
+
+      bool                               coupled = false; ///< the coupled law (hysteretic only)
+      Material::BoucWenInteraction       coupled_law;
+      Material::BoucWenInteraction::Matrix tangent_matrix; ///< D_t of the coupled law
+
+      /// H1 of spring i for output: |z_i / z_y,i|^n, or Phi^n of the facet (the same value
+      /// for the three springs) with the coupled law; 0 for linear or broken springs.
+      double
+      h1(const unsigned int i) const
+      {
+        if (!hysteretic || broken)
+          return 0.0;
+        return coupled ? coupled_law.h1(state.data(), 3) : law[i].h1(state.data() + 3 * i);
       }
     };
 
@@ -231,6 +257,7 @@ namespace hysteron
       double                        boundary_h   = 0;
       double                        shear_ratio  = 0;
       double                        moment_yield = 0.25;
+      SpringLaw                     spring_law   = SpringLaw::uncoupled;
       Analysis                      analysis     = Analysis::quasi_static;
       double                        time_step    = 0;
       unsigned int                  n_increments = 100;
