@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
 """Draw an RBSN output (rbsn-NNNNN.vtu): the Voronoi cells, optionally displaced and coloured
-by a cell field, and the broken facets (the line cells of the file) as red lines.
+by a cell field, and the broken facets (the line cells of the file with broken = 1) as red lines.
 
 Usage:
   plot_rbsn_cells.py FILE.vtu OUT.png [--field H1] [--magnify 50] [--title "..."]
                      [--xlim a b] [--ylim a b] [--label "colour bar label"]
 
-The VTU is the ASCII file hysteron writes (polygons: VTK type 7, broken facets: type 3).
+The VTU is the ASCII file hysteron writes (polygons: VTK type 7; facets: type 3, with the
+cell field broken).
 Needs python3-matplotlib (Debian's /usr/bin/python3).
 """
 import argparse
@@ -66,11 +67,13 @@ def main():
     if args.field and field is None:
         sys.exit(f"plot_rbsn_cells: {args.vtu} has no cell field '{args.field}' "
                  f"(it has: {', '.join(sorted(fields))})")
+    broken = fields.get("broken")
     start = 0
     for c, (end, kind) in enumerate(zip(offsets, types)):
         vertices = [points[k] for k in connectivity[start:end]]
         if kind == 3:
-            cracks.append(vertices)
+            if broken is None or broken[c] == 1:
+                cracks.append(vertices)
         else:
             polygons.append(vertices)
             if field is not None:

@@ -1,6 +1,7 @@
 #include <hysteron/rbsn/model.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -184,12 +185,13 @@ namespace hysteron
     Model::write_vtu(std::ostream &out) const
     {
       // The cells as polygons (moved rigidly: point data "displacement") and the
-      // broken facets as lines, in one unstructured grid.
+      // facets as lines, in one unstructured grid.
       std::vector<dealii::Point<2>> points;
       std::vector<double>           displacement;
       std::vector<unsigned int>     offsets, connectivity;
-      std::vector<int>              types, cell_index, body;
+      std::vector<int>              types, cell_index, facet_index, body;
       std::vector<double>           theta, h1;
+      std::array<std::vector<double>, 5> forces; // f_n, f_t, m, s_n, s_t of the facet lines
       std::vector<int>              broken;
       const auto add_point = [&](const dealii::Point<2> &p, const unsigned int c) {
         const dealii::Tensor<1, 2> r = p - network.cells[c].nucleus;
@@ -212,24 +214,35 @@ namespace hysteron
             offsets.push_back(connectivity.size());
             types.push_back(7); // VTK_POLYGON
             cell_index.push_back(c);
+            facet_index.push_back(-1);
             body.push_back(cell_body[c]);
             theta.push_back(u(3 * c + 2));
             h1.push_back(cell_h1[c]);
+            for (auto &f : forces)
+              f.push_back(0);
             broken.push_back(0);
           }
+      // Every facet as a line (moved with cell a): its spring forces, stresses and
+      // H1 (the largest of its springs'); broken ones have broken = 1 and no force.
       for (unsigned int e = 0; e < springs.size(); ++e)
-        if (springs[e].broken)
-          {
-            add_point(network.facets[e].p3, network.facets[e].a);
-            add_point(network.facets[e].p4, network.facets[e].a);
-            offsets.push_back(connectivity.size());
-            types.push_back(3); // VTK_LINE
-            cell_index.push_back(-1);
-            body.push_back(cell_body[network.facets[e].a]);
-            theta.push_back(0);
-            h1.push_back(0);
-            broken.push_back(1);
-          }
+        {
+          const Springs &sp = springs[e];
+          const Facet   &f  = network.facets[e];
+          add_point(f.p3, f.a);
+          add_point(f.p4, f.a);
+          offsets.push_back(connectivity.size());
+          types.push_back(3); // VTK_LINE
+          cell_index.push_back(-1);
+          facet_index.push_back(e);
+          body.push_back(cell_body[f.a]);
+          theta.push_back(0);
+          h1.push_back(std::max({sp.h1(0), sp.h1(1), sp.h1(2)}));
+          const double area = sp.thickness * f.length;
+          const double values[5] = {sp.force[0], sp.force[1], sp.force[2], sp.force[0] / area, sp.force[1] / area};
+          for (unsigned int k = 0; k < 5; ++k)
+            forces[k].push_back(sp.broken ? 0.0 : values[k]);
+          broken.push_back(sp.broken ? 1 : 0);
+        }
       out.precision(10);
       out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
              "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\""
@@ -265,10 +278,14 @@ namespace hysteron
         out << "\n</DataArray>\n";
       };
       integers("cell", cell_index);
+      integers("facet", facet_index);
       integers("body", body);
       integers("broken", broken);
       reals("rotation", theta);
       reals("H1", h1);
+      const char *force_names[5] = {"f_n", "f_t", "m", "s_n", "s_t"};
+      for (unsigned int k = 0; k < 5; ++k)
+        reals(force_names[k], forces[k]);
       out << "</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
     }
 
