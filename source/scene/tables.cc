@@ -67,7 +67,9 @@ namespace hysteron
             for (unsigned int d = 0; d < dim; ++d)
               r[d] = *p++;
         }
-      if (dealii::Utilities::MPI::this_mpi_process(comm) != 0)
+      // Only the scene's root opened the tables (comm may be a method's own, e.g.
+      // MPI_COMM_SELF for a method that every rank runs whole).
+      if (energy_table == nullptr)
         return;
       for (unsigned int i = 0; i < probe_tables.size(); ++i)
         {
