@@ -109,7 +109,7 @@ namespace hysteron
 
       template <int dim, int spacedim>
       void
-      write(const dealii::DataOutInterface<dim, spacedim> &data_out, double time);
+      write(dealii::DataOutInterface<dim, spacedim> &data_out, double time);
 
       /**
        * A VTU file that @p writer produces whole (a method's own cells, e.g. the
