@@ -98,6 +98,20 @@ namespace hysteron
 
 
     void
+    BoucWenUniaxial::throw_unstable(const double deps, const double z0, const double z) const
+    {
+      std::ostringstream m;
+      m << "Bouc-Wen (uniaxial): forward Euler is unstable at the increment " << deps
+        << " (z/z_y = " << z0 / z_y << " -> " << z / z_y
+        << ", beyond the saturation value by more than one increment; n = " << n
+        << ", stable for increments up to about 2 z_y/n = " << 2 * z_y / n
+        << "): reduce the increments or use the adaptive or backward euler integrator";
+      throw RuntimeError(m.str());
+    }
+
+
+
+    void
     BoucWenUniaxial::throw_too_many_substeps(const double deps, const double z) const
     {
       std::ostringstream m;

@@ -763,3 +763,23 @@ TEST(BoucWenUniaxial, IncrementsBelowRoundOff)
           EXPECT_LE(tangent, E * (1 + 1e-12));
         }
 }
+
+
+
+// Forward Euler beyond its stability limit (deps/z_y <~ 2/n): on triangular cycles of
+// +-5 z_y in increments z_y/2, n = 8 overshoots but stays bounded (|z| <= z_y + deps),
+// while n = 32 diverges; the step that leaves that bound is a RuntimeError (before, z
+// grew to inf and NaN without an error; tests/stability/bouc_wen_forward_euler_unstable).
+TEST(BoucWenUniaxial, ForwardEulerInstabilityIsAnError)
+{
+  std::vector<double> eps{0.0};
+  for (unsigned int cycle = 0; cycle < 20; ++cycle)
+    for (const double direction : {1.0, -1.0, -1.0, 1.0})
+      for (unsigned int i = 0; i < 10; ++i)
+        eps.push_back(eps.back() + direction * 0.5 * z_y);
+  const Response r = drive(BoucWenUniaxial(parameters(8, BoucWenIntegrator::forward_euler), E), eps);
+  for (const auto &s : r.state)
+    ASSERT_LE(std::abs(s[0]), 1.5 * z_y);
+  EXPECT_THROW(drive(BoucWenUniaxial(parameters(32, BoucWenIntegrator::forward_euler), E), eps),
+               hysteron::RuntimeError);
+}

@@ -87,7 +87,9 @@ namespace hysteron
      * The rate equations are integrated in pseudo-time over the increment
      * (eps' = deps, so y(1) = y(0) + int_0^1 f(y) ds):
      * - forward euler: one evaluation at the start state (first order; stable
-     *   only for deps / z_y <~ 2 / n, DESIGN.md §3);
+     *   only for deps / z_y <~ 2 / n, DESIGN.md §3); a step that ends farther
+     *   beyond the saturation value z_s than one increment can reach from inside
+     *   it (the scheme has become unstable, inf and NaN follow) is a RuntimeError;
      * - adaptive: Bogacki-Shampine 3(2) with first-same-as-last and error
      *   control (error of z scaled by z_y, of eta absolute, of e_h by y z_y,
      *   each per sub-step against the Tolerance; the third-order solution is
@@ -390,6 +392,8 @@ namespace hysteron
 
       [[noreturn]] void
       throw_not_finite(const double deps, const double z) const;
+      [[noreturn]] void
+      throw_unstable(const double deps, const double z0, const double z) const;
       [[noreturn]] void
       throw_too_many_substeps(const double deps, const double z) const;
       [[noreturn]] void
@@ -717,6 +721,15 @@ namespace hysteron
           const Vector<degrading_> f = rates<degrading_>(v, deps);
           for (unsigned int i = 0; i < v.size(); ++i)
             v[i] += f[i];
+          // From |z| <= z_s a step moves z by at most |deps| max(1, nu_s - 1) (the
+          // factor 1 - nu_s H1 H2 lies in [1 - nu_s, 1] there, and eta >= 1). Beyond
+          // that the explicit scheme has left the admissible set and is unstable:
+          // |z| then grows without bound to inf and NaN within a few increments.
+          double reach = std::abs(deps);
+          if constexpr (degrading_)
+            reach *= std::max(1.0, c_nu_scaled * state[energy_index]);
+          if (!(std::abs(v[0]) <= z_saturation + reach))
+            throw_unstable(deps, z0, v[0]);
         }
       else if constexpr (integrator_ == BoucWenIntegrator::adaptive)
         {
