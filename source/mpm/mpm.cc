@@ -945,6 +945,12 @@ namespace hysteron
             m << " moved to " << format_point(x_new, dim) << " (grid from "
               << format_point(&lower[0], dim) << " to " << format_point(&upper[0], dim)
               << "; enlarge MPM/Grid or check the loads and boundary conditions)";
+          if (step_dt > step_critical)
+            m << "; the fixed time step " << step_dt << " s is " << step_dt / step_critical
+              << " times the critical step " << step_critical
+              << " s = h / max_p(c_p + |v_p|) (MPM/Maximum CFL number = " << maximum_cfl
+              << "): the explicit scheme is probably unstable, use Time/Time step <= " << step_critical
+              << " s";
           m << ". The last good state (t = " << t << " s) was written.";
           message = m.str();
         }
@@ -1019,7 +1025,9 @@ namespace hysteron
                   fail(m.str(), t);
                 }
             }
-          dt = std::min(dt, time.end_time - t);
+          dt            = std::min(dt, time.end_time - t);
+          step_critical = critical;
+          step_dt       = dt;
           {
             dealii::TimerOutput::Scope timing(scene.timer(), "steps");
             if (basis_name == "linear")

@@ -46,6 +46,10 @@ namespace hysteron
                        std::vector<dealii::Tensor<1, dim>> reactions,
                        const MPI_Comm                      comm)
     {
+      if (has_written && t == last_time)
+        return;
+      has_written = true;
+      last_time   = t;
       // One reduction of everything, and none on one rank.
       if (dealii::Utilities::MPI::n_mpi_processes(comm) > 1)
         {

@@ -368,6 +368,9 @@ namespace hysteron
       unsigned long n_steps = 0, n_newton = 0, n_cuts = 0, n_linear = 0;
       unsigned int  n_outputs = 0;
       double        critical_step = 0;
+      /// Explicit dynamics: the kinetic energy at t = 0 (whole mesh; < 0 before the
+      /// first step), for the divergence check of explicit_step().
+      double        initial_kinetic = -1;
       std::string   solver_name;
     };
   } // namespace FEM

@@ -105,6 +105,8 @@ namespace hysteron
       double                        flip_fraction = 1.0;
       bool                          jaumann       = false;
       double                        maximum_cfl   = 1.0;
+      /// The critical step and the step of the step being taken (for failure messages).
+      double                        step_critical = 0, step_dt = 0;
       double                        probe_interval = 0.0;
       bool                          particle_table = false;
       std::vector<Geometry::Region<dim>> average_regions;

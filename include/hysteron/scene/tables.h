@@ -48,7 +48,8 @@ namespace hysteron
        * mass, then the mass-weighted sums of the point values), @p energies
        * (kinetic, strain energy, internal, external and boundary work) and
        * @p reactions (one per column pair of reactions.csv). The arrays are
-       * summed in place.
+       * summed in place. A second row at the time of the last one is not written
+       * (every rank skips it, before the reduction).
        */
       void
       write(const double                         t,
@@ -67,6 +68,10 @@ namespace hysteron
       std::unique_ptr<Output::CsvWriter>              energy_table, reaction_table;
       EnergyLog                                       energy_log;
       unsigned int                                    n_values = 0;
+      /// The time of the last row (a failing run writes its last good state, which
+      /// may be the row just written: it is not repeated).
+      double last_time   = 0;
+      bool   has_written = false;
     };
 
     /**
