@@ -48,7 +48,7 @@ namespace hysteron
       // dt = 0: the forces of the state u_iterate only (the initial state).
       const bool        dynamic = analysis == Analysis::implicit_dynamics && dt > 0;
       const bool        system  = analysis != Analysis::explicit_dynamics;
-      const double      alpha = hht_alpha, beta = (1 - alpha) * (1 - alpha) / 4, gamma = 0.5 - alpha;
+      const double      alpha = dynamics.hht_alpha, beta = dynamics.beta(), gamma = dynamics.gamma();
       const double      t0 = t1 - dt;
 
       if (matrix)
@@ -195,7 +195,7 @@ namespace hysteron
                       for (unsigned int j = 0; j < n; ++j)
                         if (comp[i] == comp[j])
                           M(i, j) += rho * fv.shape_value(i, q) * fv.shape_value(j, q) * w;
-                    if (rayleigh_stiffness > 0)
+                    if (dynamics.rayleigh_stiffness > 0)
                       for (unsigned int j = 0; j < n; ++j)
                         {
                           const SymmetricTensor<2, dim> DB = D * B[q][j];
@@ -219,22 +219,22 @@ namespace hysteron
                 M.vmult(Mv, a1);
                 M.vmult(Cv0, v0);
                 M.vmult(Cv1, v1);
-                Cv0 *= rayleigh_mass;
-                Cv1 *= rayleigh_mass;
-                if (rayleigh_stiffness > 0)
+                Cv0 *= dynamics.rayleigh_mass;
+                Cv1 *= dynamics.rayleigh_mass;
+                if (dynamics.rayleigh_stiffness > 0)
                   {
                     K0.vmult(tmp, v0);
-                    Cv0.add(rayleigh_stiffness, tmp);
+                    Cv0.add(dynamics.rayleigh_stiffness, tmp);
                     K0.vmult(tmp, v1);
-                    Cv1.add(rayleigh_stiffness, tmp);
+                    Cv1.add(dynamics.rayleigh_stiffness, tmp);
                   }
                 for (unsigned int i = 0; i < n; ++i)
                   r[i] = Mv[i] + (1 + alpha) * (Cv1[i] + fi[i] - fx[i]) -
                          alpha * (Cv0[i] + fi0[i] - fx0[i]);
                 if (matrix)
                   {
-                    const double c_M = 1 / (beta * dt * dt) + (1 + alpha) * gamma / (beta * dt) * rayleigh_mass;
-                    const double c_K0 = (1 + alpha) * gamma / (beta * dt) * rayleigh_stiffness;
+                    const double c_M = 1 / (beta * dt * dt) + (1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_mass;
+                    const double c_K0 = (1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_stiffness;
                     for (unsigned int i = 0; i < n; ++i)
                       for (unsigned int j = 0; j < n; ++j)
                         A(i, j) = (1 + alpha) * A(i, j) + c_M * M(i, j) + c_K0 * K0(i, j);
@@ -320,14 +320,7 @@ namespace hysteron
       increment -= u;
       if (analysis == Analysis::implicit_dynamics)
         {
-          const double alpha = hht_alpha, beta = (1 - alpha) * (1 - alpha) / 4, gamma = 0.5 - alpha;
-          // a1 = (du - dt v0) / (beta dt^2) - (1 - 2 beta) / (2 beta) a0; v1 = v0 + dt ((1 - gamma) a0 + gamma a1).
-          Vector a_new = increment;
-          a_new.add(-dt, v);
-          a_new *= 1 / (beta * dt * dt);
-          a_new.add(-(1 - 2 * beta) / (2 * beta), a);
-          v.add(dt * (1 - gamma), a, dt * gamma, a_new);
-          a = a_new;
+          dynamics.update(increment, dt, v, a);
           v_ghost = v;
           a_ghost = a;
         }

@@ -55,16 +55,16 @@ namespace hysteron
     Solver<dim>::damping_force(const Vector &velocity, Vector &force, const double factor) const
     {
       // force += factor C v, C = a0 M_L + a1 K0 (matrix-free).
-      if (rayleigh_mass > 0)
+      if (dynamics.rayleigh_mass > 0)
         for (const auto i : owned_dofs)
-          force(i) += factor * rayleigh_mass * lumped_mass(i) * velocity(i);
-      if (rayleigh_stiffness > 0)
+          force(i) += factor * dynamics.rayleigh_mass * lumped_mass(i) * velocity(i);
+      if (dynamics.rayleigh_stiffness > 0)
         {
           Vector ghost(owned_dofs, relevant_dofs, this->get_scene().mpi_communicator());
           ghost = velocity;
           Vector Kv(owned_dofs, this->get_scene().mpi_communicator());
           elastic_stiffness_product(ghost, Kv);
-          force.add(factor * rayleigh_stiffness, Kv);
+          force.add(factor * dynamics.rayleigh_stiffness, Kv);
         }
       force.compress(dealii::VectorOperation::add);
     }
@@ -255,18 +255,18 @@ namespace hysteron
             for (unsigned int i = 0; i < n; ++i)
               ve[i] = v_ghost(dofs[i]);
             M.vmult(rhs, ve);
-            rhs *= -rayleigh_mass;
+            rhs *= -dynamics.rayleigh_mass;
             constraints.distribute_local_to_global(M, rhs, dofs, system_matrix, system_rhs);
           }
       system_matrix.compress(VectorOperation::add);
       system_rhs.compress(VectorOperation::add);
       Vector force = f_ext;
       force -= f_int;
-      if (rayleigh_stiffness > 0)
+      if (dynamics.rayleigh_stiffness > 0)
         {
           Vector Kv(owned_dofs, this->get_scene().mpi_communicator());
           elastic_stiffness_product(v_ghost, Kv);
-          force.add(-rayleigh_stiffness, Kv);
+          force.add(-dynamics.rayleigh_stiffness, Kv);
         }
       for (const auto i : owned_dofs)
         if (!constraints.is_constrained(i))

@@ -144,24 +144,7 @@ namespace hysteron
         prm.leave_subsection();
 
         prm.enter_subsection("Dynamics");
-        {
-          prm.declare_entry("HHT alpha",
-                            "0",
-                            Patterns::Double(),
-                            "Implicit dynamics: the Hilber-Hughes-Taylor parameter alpha in "
-                            "[-1/3, 0] (beta = (1 - alpha)^2 / 4, gamma = 1/2 - alpha); 0 is the "
-                            "Newmark average acceleration rule (no numerical damping).");
-          prm.declare_entry("Rayleigh mass coefficient",
-                            "0",
-                            Patterns::Double(),
-                            "Rayleigh damping C = a0 M + a1 K0 (K0: the initial elastic "
-                            "stiffness): a0 [1/s], >= 0. Damping ratio xi(omega) = a0 / (2 omega) "
-                            "+ a1 omega / 2.");
-          prm.declare_entry("Rayleigh stiffness coefficient",
-                            "0",
-                            Patterns::Double(),
-                            "Rayleigh damping: a1 [s], >= 0.");
-        }
+        ImplicitDynamicsParameters::declare_parameters(prm);
         prm.leave_subsection();
 
         prm.enter_subsection("Linear solver");
@@ -251,15 +234,7 @@ namespace hysteron
       {
         newton.parse_parameters(Section(prm, {"FEM", "Newton"}));
       }
-      {
-        Section s(prm, {"FEM", "Dynamics"});
-        hht_alpha = s.get_double("HHT alpha");
-        require(hht_alpha >= -1.0 / 3.0 - 1e-14 && hht_alpha <= 0,
-                s.where("HHT alpha"),
-                "must be in [-1/3, 0] (got " + s.get("HHT alpha") + ")");
-        rayleigh_mass      = s.get_non_negative("Rayleigh mass coefficient");
-        rayleigh_stiffness = s.get_non_negative("Rayleigh stiffness coefficient");
-      }
+      dynamics.parse_parameters(Section(prm, {"FEM", "Dynamics"}));
       {
         Section           s(prm, {"FEM", "Linear solver"});
         const std::string type = s.get("Type");

@@ -122,11 +122,7 @@ namespace hysteron
         NewtonParameters::declare_parameters(prm);
         prm.leave_subsection();
         prm.enter_subsection("Dynamics");
-        {
-          prm.declare_entry("HHT alpha", "0", Patterns::Double(), "In [-1/3, 0]; 0: Newmark average acceleration.");
-          prm.declare_entry("Rayleigh mass coefficient", "0", Patterns::Double(), "a0 [1/s] of C = a0 M + a1 K0, >= 0.");
-          prm.declare_entry("Rayleigh stiffness coefficient", "0", Patterns::Double(), "a1 [s], >= 0 (K0: the elastic stiffness).");
-        }
+        ImplicitDynamicsParameters::declare_parameters(prm);
         prm.leave_subsection();
         prm.enter_subsection("Fracture");
         {
@@ -182,15 +178,7 @@ namespace hysteron
         spring_table = s.get_bool("Write spring table");
       }
       newton.parse_parameters(Section(prm, {"RBSN", "Newton"}));
-      {
-        Section s(prm, {"RBSN", "Dynamics"});
-        hht_alpha = s.get_double("HHT alpha");
-        require(hht_alpha >= -1.0 / 3.0 - 1e-14 && hht_alpha <= 0,
-                s.where("HHT alpha"),
-                "must be in [-1/3, 0] (got " + s.get("HHT alpha") + ")");
-        rayleigh_mass      = s.get_non_negative("Rayleigh mass coefficient");
-        rayleigh_stiffness = s.get_non_negative("Rayleigh stiffness coefficient");
-      }
+      dynamics.parse_parameters(Section(prm, {"RBSN", "Dynamics"}));
       {
         Section s(prm, {"RBSN", "Fracture"});
         fracture.enabled = s.get_bool("Enabled");

@@ -296,9 +296,7 @@ namespace hysteron
     {
       if (!scene.output_control().write_vtu)
         return;
-      // Every rank holds the whole network (the RBSN is serial): rank 0 writes.
-      if (scene.is_root())
-        field_writer->write_serial([this](std::ostream &out) { write_vtu(out); }, t);
+      field_writer->write_serial([this](std::ostream &out) { write_vtu(out); }, t);
       ++n_outputs;
     }
 

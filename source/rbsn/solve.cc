@@ -27,7 +27,7 @@ namespace hysteron
     Model::assemble(const double t1, const double dt, const bool with_matrix, const bool update_springs)
     {
       const bool   dynamic = analysis == Analysis::implicit_dynamics && dt > 0;
-      const double alpha = hht_alpha, beta = (1 - alpha) * (1 - alpha) / 4, gamma = 0.5 - alpha;
+      const double alpha = dynamics.hht_alpha, beta = dynamics.beta(), gamma = dynamics.gamma();
       if (with_matrix)
         matrix = 0;
       rhs     = 0;
@@ -151,7 +151,7 @@ namespace hysteron
               r.add(-alpha, fe0);
               if (with_matrix)
                 K *= 1 + alpha;
-              if (rayleigh_stiffness > 0)
+              if (dynamics.rayleigh_stiffness > 0)
                 {
                   for (unsigned int p = 0; p < 6; ++p)
                     for (unsigned int q = 0; q < 6; ++q)
@@ -168,13 +168,13 @@ namespace hysteron
                       ve1[k] = ve0[k] + dt * ((1 - gamma) * a(dofs[k]) + gamma * a1);
                     }
                   K0.vmult(tmp, ve1);
-                  r.add((1 + alpha) * rayleigh_stiffness, tmp);
+                  r.add((1 + alpha) * dynamics.rayleigh_stiffness, tmp);
                   for (unsigned int k = 0; k < 6; ++k)
-                    inertia(dofs[k]) += rayleigh_stiffness * tmp[k];
+                    inertia(dofs[k]) += dynamics.rayleigh_stiffness * tmp[k];
                   K0.vmult(tmp, ve0);
-                  r.add(-alpha * rayleigh_stiffness, tmp);
+                  r.add(-alpha * dynamics.rayleigh_stiffness, tmp);
                   if (with_matrix)
-                    K.add((1 + alpha) * gamma / (beta * dt) * rayleigh_stiffness, K0);
+                    K.add((1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_stiffness, K0);
                 }
             }
           for (unsigned int k = 0; k < 6; ++k)
@@ -192,7 +192,7 @@ namespace hysteron
           dealii::FullMatrix<double>                   M(3, 3);
           dealii::Vector<double>                       a1(3), v1(3), v0(3), rc(3), Mx(3);
           std::vector<dealii::types::global_dof_index> cd(3);
-          const double c_M = 1 / (beta * dt * dt) + (1 + alpha) * gamma / (beta * dt) * rayleigh_mass;
+          const double c_M = 1 / (beta * dt * dt) + (1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_mass;
           for (unsigned int c = 0; c < network.cells.size(); ++c)
             {
               cell_mass_matrix(c, M);
@@ -207,10 +207,10 @@ namespace hysteron
               M.vmult(rc, a1);
               M.vmult(Mx, v1);
               for (unsigned int k = 0; k < 3; ++k)
-                inertia(cd[k]) += rc[k] + rayleigh_mass * Mx[k];
-              rc.add((1 + alpha) * rayleigh_mass, Mx);
+                inertia(cd[k]) += rc[k] + dynamics.rayleigh_mass * Mx[k];
+              rc.add((1 + alpha) * dynamics.rayleigh_mass, Mx);
               M.vmult(Mx, v0);
-              rc.add(-alpha * rayleigh_mass, Mx);
+              rc.add(-alpha * dynamics.rayleigh_mass, Mx);
               rc *= -1.0;
               if (with_matrix)
                 {
@@ -338,13 +338,7 @@ namespace hysteron
       increment -= u;
       if (analysis == Analysis::implicit_dynamics && dt > 0)
         {
-          const double alpha = hht_alpha, beta = (1 - alpha) * (1 - alpha) / 4, gamma = 0.5 - alpha;
-          for (unsigned int i = 0; i < u.size(); ++i)
-            {
-              const double a1 = (increment(i) - dt * v(i)) / (beta * dt * dt) - (1 - 2 * beta) / (2 * beta) * a(i);
-              v(i) += dt * ((1 - gamma) * a(i) + gamma * a1);
-              a(i) = a1;
-            }
+          dynamics.update(increment, dt, v, a);
         }
       else if (dt > 0)
         {
@@ -431,8 +425,8 @@ namespace hysteron
       force -= f_int;
       Vector Mv(v.size());
       matrix.vmult(Mv, v);
-      force.add(-rayleigh_mass, Mv);
-      if (rayleigh_stiffness > 0)
+      force.add(-dynamics.rayleigh_mass, Mv);
+      if (dynamics.rayleigh_stiffness > 0)
         for (unsigned int e = 0; e < springs.size(); ++e)
           {
             const Facet   &f  = network.facets[e];
@@ -442,7 +436,7 @@ namespace hysteron
               {
                 const double kv = sp.k[i] * sp.deformation(i, U);
                 for (unsigned int k = 0; k < 6; ++k)
-                  force(k < 3 ? 3 * f.a + k : 3 * f.b + k - 3) -= rayleigh_stiffness * sp.B(i, k) * kv;
+                  force(k < 3 ? 3 * f.a + k : 3 * f.b + k - 3) -= dynamics.rayleigh_stiffness * sp.B(i, k) * kv;
               }
           }
       for (unsigned int i = 0; i < rhs.size(); ++i)
@@ -469,8 +463,9 @@ namespace hysteron
         setup_springs();
         setup_system();
         setup_conditions();
+        // Every rank holds the whole network; write_serial() writes on rank 0.
         field_writer = std::make_unique<Output::FieldWriter>(method.output_directory(), "rbsn",
-                                                             MPI_COMM_SELF);
+                                                             scene.mpi_communicator());
         open_tables();
       }
       scene.console() << "rbsn: " << network.cells.size() << " cells, " << network.facets.size()

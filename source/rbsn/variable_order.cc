@@ -308,7 +308,7 @@ namespace hysteron
     {
       prescribed_velocities(t);
       m.external_forces(t, f_ext);
-      const double a0 = m.rayleigh_mass, a1 = m.rayleigh_stiffness;
+      const double a0 = m.dynamics.rayleigh_mass, a1 = m.dynamics.rayleigh_stiffness;
       F = 0;
       // Kinematics.
       for (unsigned int i = 0; i < n; ++i)
@@ -385,7 +385,7 @@ namespace hysteron
     int
     Model::VariableOrder::setup_jacobian(const Vector &y, const double cj)
     {
-      const double a0 = m.rayleigh_mass, a1 = m.rayleigh_stiffness;
+      const double a0 = m.dynamics.rayleigh_mass, a1 = m.dynamics.rayleigh_stiffness;
       jacobian = 0;
       for (unsigned int i = 0; i < n; ++i)
         {

@@ -11,6 +11,7 @@
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 
+#include <hysteron/base/implicit_dynamics.h>
 #include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>
 #include <hysteron/geometry/region.h>
@@ -162,8 +163,7 @@ namespace hysteron
       unsigned int  refinements  = 0;
       std::string   mesh_file;
       NewtonParameters newton;
-      double        hht_alpha  = 0;
-      double        rayleigh_mass = 0, rayleigh_stiffness = 0;
+      ImplicitDynamicsParameters dynamics;
       LinearSolver  solver_type = LinearSolver::automatic;
       unsigned long direct_limit = 100000;
       std::string   direct_package = "Amesos_Klu";

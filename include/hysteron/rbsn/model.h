@@ -8,6 +8,7 @@
 #include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/vector.h>
 
+#include <hysteron/base/implicit_dynamics.h>
 #include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>
 #include <hysteron/base/progress.h>
@@ -262,7 +263,7 @@ namespace hysteron
       double                        time_step    = 0;
       unsigned int                  n_increments = 100;
       NewtonParameters              newton;
-      double                        hht_alpha = 0, rayleigh_mass = 0, rayleigh_stiffness = 0;
+      ImplicitDynamicsParameters    dynamics;
       FractureParameters            fracture;
       VariableOrderParameters       variable_order;
       bool                          spring_table = false;
