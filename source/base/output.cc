@@ -112,6 +112,9 @@ namespace hysteron
     void
     FieldWriter::write(dealii::DataOutInterface<dim, spacedim> &data_out, const double time)
     {
+      // A failing run writes its last good state, which may already be written.
+      if (!times_and_names.empty() && times_and_names.back().first == time)
+        return;
       // zlib's fastest level: the default (best compression) made writing a particle
       // VTU cost about four times the 40 steps between two outputs
       // (doc/benchmarks/pay_for_use.md); the files are a little larger.
@@ -165,6 +168,8 @@ namespace hysteron
     void
     FieldWriter::write_serial(const std::function<void(std::ostream &)> &writer, const double time)
     {
+      if (!times_and_names.empty() && times_and_names.back().first == time)
+        return;
       const std::string record = base_name + "-" + dealii::Utilities::int_to_string(counter, 5) + ".vtu";
       times_and_names.emplace_back(time, record);
       ++counter;

@@ -329,13 +329,9 @@ namespace hysteron
 
       // The members keep the state of t until the step has passed its checks: a failing
       // step writes the tables of t (fail()), not a mixture with the failed step (its
-      // forces are restored, its velocity and acceleration not yet assigned).
-      const Vector f_int_t = f_int, f_ext_t = f_ext;
-      const auto   fail_step = [&](const std::string &what) {
-        f_int = f_int_t;
-        f_ext = f_ext_t;
-        fail(what, t);
-      };
+      // velocity and acceleration are not yet assigned; the reactions are the converged
+      // reaction_old, not the f_int and f_ext that assemble() overwrites).
+      const auto fail_step = [&](const std::string &what) { fail(what, t); };
       Vector ghost(owned_dofs, relevant_dofs, comm);
       ghost = u_trial;
       if (!assemble(ghost, t1, dt, Assemble::forces))

@@ -995,6 +995,10 @@ namespace hysteron
                            "the residuals)";
                       if (!material_failure.empty())
                         m << "; the last failure was in the material: " << material_failure;
+                      else
+                        m << "; the last residual was " << system_rhs.l2_norm() / force_level()
+                          << " of the force level (tolerance "
+                          << std::max(newton.tolerance, residual_floor()) << ")";
                       m << ".";
                       fail(m.str(), t);
                     }

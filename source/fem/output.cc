@@ -116,13 +116,15 @@ namespace hysteron
     Solver<dim>::reactions() const
     {
       // The force of each constraint on the body: f_int + M a + C v - f_ext at its DoFs
-      // (this rank's part).
+      // (this rank's part), of the converged state (reaction_old, set by commit()): f_int,
+      // f_ext and inertia hold the last evaluation, which is a failed iterate when a run
+      // stops because Newton or a material failed.
       std::vector<dealii::Tensor<1, dim>> r(dirichlet.size());
       for (unsigned int k = 0; k < constrained_list.size(); ++k)
         {
           const auto dof = constrained_list[k];
           if (owned_dofs.is_element(dof))
-            r[constrained_set[k]][constrained_component[k]] += f_int(dof) + inertia(dof) - f_ext(dof);
+            r[constrained_set[k]][constrained_component[k]] += reaction_old(dof);
         }
       for (unsigned int s = 0; s < dirichlet.size() && s < wall_forces.size(); ++s)
         r[s] += wall_forces[s];

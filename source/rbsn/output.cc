@@ -97,17 +97,15 @@ namespace hysteron
 
 
 
-    void
-    Model::record_break(const unsigned int e, const double t)
+    std::vector<double>
+    Model::break_row(const unsigned int e, const double t) const
     {
       const Springs &sp   = springs[e];
       const double   area = sp.thickness * network.facets[e].length;
       const double   s_n = sp.trial_force[0] / area, s_t = sp.trial_force[1] / area;
       const double   R = std::max(s_n / fracture.tensile_strength,
                                 (std::abs(s_t) + fracture.friction * s_n) / fracture.cohesion);
-      if (fracture_table)
-        fracture_table->add_row({t, double(e), network.facets[e].midpoint[0],
-                                 network.facets[e].midpoint[1], s_n, s_t, R});
+      return {t, double(e), network.facets[e].midpoint[0], network.facets[e].midpoint[1], s_n, s_t, R};
     }
 
 
@@ -170,10 +168,13 @@ namespace hysteron
                 }
             }
 
+      // The reactions f_int + inertia - f_ext of the converged state (reaction_old, set by
+      // commit()): f_int and inertia hold the last evaluation, a failed iterate when the
+      // run stops.
       std::vector<dealii::Tensor<1, 2>> reactions(dirichlet.size());
       for (unsigned int i = 0; i < u.size(); ++i)
         if (dof_set[i] >= 0 && i % 3 < 2)
-          reactions[dof_set[i]][i % 3] += f_int(i) + inertia(i) - f_ext(i);
+          reactions[dof_set[i]][i % 3] += reaction_old(i);
       tables.write(t, rows, averages,
                    {{kinetic, strain_energy, internal_work, external_work, boundary_work}},
                    reactions, MPI_COMM_SELF);

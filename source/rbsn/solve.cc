@@ -6,6 +6,7 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <vector>
 
 namespace hysteron
 {
@@ -501,7 +502,30 @@ namespace hysteron
       if (analysis == Analysis::variable_order)
         t = integrate_variable_order(nominal, rows, fields, progress);
       const double eps = 1e-12 * time.end_time;
-      unsigned int broken_at_t = n_broken; // facets broken up to the converged state t
+      // The facets broken since the converged state t in this attempt of the increment,
+      // with their fracture.csv rows. They are intact again when the increment is cut (a
+      // break decided at a load the shorter step does not reach) and in the last good
+      // state a failing run writes; their rows are written when the increment converges,
+      // and by a failing run (what broke in the failed attempt).
+      std::vector<unsigned int>        broken_since_t;
+      std::vector<std::vector<double>> break_rows;
+      const auto                       restore_t = [&]() {
+        for (const unsigned int e : broken_since_t)
+          springs[e].broken = false;
+        n_broken -= broken_since_t.size();
+        broken_since_t.clear();
+      };
+      const auto write_breaks = [&]() {
+        if (fracture_table)
+          for (const auto &row : break_rows)
+            fracture_table->add_row(row);
+        break_rows.clear();
+      };
+      const auto fail_at_t = [&](const std::string &what) {
+        restore_t();
+        write_breaks();
+        fail(what, t);
+      };
       while (t < time.end_time - eps)
         {
           const double dt = increments.step(t, time.end_time);
@@ -514,7 +538,7 @@ namespace hysteron
               }
             catch (const RuntimeError &error)
               {
-                fail(std::string(error.what()) + " (step to t = " + std::to_string(t + dt) + " s).", t);
+                fail_at_t(std::string(error.what()) + " (step to t = " + std::to_string(t + dt) + " s).");
               }
             // Fracture: break the facet with the largest R > 1, solve the step again.
             for (unsigned int cycle = 0; converged && fracture.enabled; ++cycle)
@@ -523,28 +547,24 @@ namespace hysteron
                 if (e < 0)
                   break;
                 if (cycle >= fracture.max_cycles)
-                  fail("rbsn: more than " + std::to_string(fracture.max_cycles) +
-                         " facets break in the step to t = " + std::to_string(t + dt) +
-                         " s: the network falls apart.",
-                       t);
-                record_break(e, t + dt);
+                  fail_at_t("rbsn: more than " + std::to_string(fracture.max_cycles) +
+                            " facets break in the step to t = " + std::to_string(t + dt) +
+                            " s: the network falls apart.");
+                break_rows.push_back(break_row(e, t + dt));
                 springs[e].broken = true;
                 ++n_broken;
+                broken_since_t.push_back(e);
                 try
                   {
                     converged = solve_step(t, dt);
                   }
                 catch (const RuntimeError &error)
                   {
-                    // The last good state (t) had the facet intact; the break is in fracture.csv.
-                    springs[e].broken = false;
-                    --n_broken;
                     std::ostringstream where;
                     where << network.facets[e].midpoint;
-                    fail(std::string(error.what()) + " after the facet at (" + where.str() +
-                           ") broke at t = " +
-                           std::to_string(t + dt) + " s: the structure has fallen apart.",
-                         t);
+                    fail_at_t(std::string(error.what()) + " after the facet at (" + where.str() +
+                              ") broke at t = " + std::to_string(t + dt) +
+                              " s: the structure has fallen apart.");
                   }
               }
           }
@@ -554,20 +574,28 @@ namespace hysteron
                 {
                   std::ostringstream m;
                   m << "rbsn: Newton did not converge in the increment from t = " << t << " s to "
-                    << t + dt << " s after " << newton.max_cuts << " cuts: the structure may have "
-                    << "reached its limit load (use displacement control)";
-                  if (n_broken > broken_at_t)
-                    m << "; " << n_broken - broken_at_t << " facets broke in this increment, the "
-                      << "network may have fallen apart";
+                    << t + dt << " s (increment " << dt << " s = " << nominal << " s / 2^"
+                    << newton.max_cuts << ") after " << newton.max_cuts
+                    << " cuts: the structure may have reached its limit load (use displacement "
+                    << "control)";
+                  if (!broken_since_t.empty())
+                    m << "; " << broken_since_t.size() << " facets broke in its last attempt, "
+                      << "the network may have fallen apart";
                   if (!spring_failure.empty())
                     m << "; the last failure was in a spring: " << spring_failure;
+                  else
+                    m << "; the last residual was " << rhs.l2_norm() / force_level()
+                      << " of the force level (tolerance " << newton.tolerance << ")";
                   m << ".";
-                  fail(m.str(), t);
+                  fail_at_t(m.str());
                 }
+              restore_t();
+              break_rows.clear();
               continue;
             }
           commit(t + dt, dt);
-          broken_at_t = n_broken;
+          broken_since_t.clear();
+          write_breaks();
           increments.accept(t, dt);
           n_cuts = increments.cuts();
           ++n_steps;

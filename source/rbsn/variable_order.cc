@@ -514,7 +514,6 @@ namespace hysteron
       Vector F(n_total);
       residual(t, y, yp, F); // reaction = f_int + M v' + C v - f_ext, f_ext at t
       m.f_ext = f_ext;
-      m.f_int = 0;
       std::array<double, 6> U;
       for (unsigned int i = 0; i < n; ++i)
         {
@@ -539,17 +538,13 @@ namespace hysteron
                 }
               else
                 sp.force[i] = sp.k[i] * sp.delta[i];
-              for (unsigned int k = 0; k < 6; ++k)
-                m.f_int(dofs[k]) += sp.B(i, k) * sp.force[i];
             }
           sp.trial_delta = sp.delta;
           sp.trial_force = sp.force;
           sp.trial_state = sp.state;
         }
-      // The output's reactions are f_int + inertia - f_ext: inertia = M v' + C v.
-      m.inertia = reaction;
-      m.inertia += f_ext;
-      m.inertia -= m.f_int;
+      // The output's reactions: f_int + M v' + C v - f_ext.
+      m.reaction_old = reaction;
       m.u_trial = m.u;
       const unsigned int iw = 2 * n + n_states;
       m.internal_work       = y(iw);

@@ -98,9 +98,10 @@ namespace hysteron
      * Field output for ParaView: every call to write() produces
      * "<base>-<step>.vtu" (on one rank) or "<base>-<step>.<rank>.vtu" plus a
      * ".pvtu" record (on several), and rewrites "<base>.pvd" with the list of
-     * (time, file). All files are written atomically. Works for any
-     * DataOutInterface: DataOut (FEM, background grid), Particles::DataOut (MPM),
-     * or the custom patches of the RBSN cells.
+     * (time, file); a second call at the time of the last record writes nothing
+     * (a failing run writes its last good state). All files are written
+     * atomically. Works for any DataOutInterface: DataOut (FEM, background
+     * grid), Particles::DataOut (MPM), or the custom patches of the RBSN cells.
      */
     class FieldWriter
     {

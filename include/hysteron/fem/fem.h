@@ -347,7 +347,9 @@ namespace hysteron
       std::vector<dealii::Tensor<1, dim>>   wall_forces;     ///< per Dirichlet set, last step
 
       // The state: displacement, velocity, acceleration (owned and ghosted), the
-      // converged forces, and the lumped mass of explicit dynamics.
+      // forces, and the lumped mass of explicit dynamics. f_int, f_ext and inertia are
+      // those of the last evaluation (an iterate); f_int_old, f_ext_old and reaction_old
+      // (f_int + inertia - f_ext) those of the converged state, which the output reads.
       Vector u, u_ghost, v, v_ghost, a, a_ghost, u_trial;
       Vector f_int, f_ext, f_int_old, f_ext_old, inertia, lumped_mass, reaction_old;
       dealii::BoundingBox<dim> mesh_box;

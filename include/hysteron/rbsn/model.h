@@ -212,8 +212,9 @@ namespace hysteron
       {
         return std::max({last_force_level, 1e-3 * force_scale, 1e-6 * predictor_level});
       }
-      void
-      record_break(const unsigned int facet, const double t);
+      /// The fracture.csv row of a break of @p facet at time @p t (its trial forces).
+      std::vector<double>
+      break_row(const unsigned int facet, const double t) const;
       void
       open_tables();
       void
@@ -284,6 +285,8 @@ namespace hysteron
       dealii::SparseMatrix<double>      matrix;
       dealii::SparseDirectUMFPACK       direct;
       dealii::AffineConstraints<double> constraints;
+      /// f_int, f_ext and inertia: the last evaluation (an iterate); f_ext_old and
+      /// reaction_old (f_int + inertia - f_ext): the converged state, which the output reads.
       Vector u, u_trial, v, a, rhs, f_int, f_ext, f_ext_old, inertia, reaction_old;
       std::vector<Dirichlet> dirichlet;
       std::vector<int>       dof_set; ///< the Dirichlet set of each DoF, -1 if free
