@@ -16,6 +16,8 @@ fi
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 echo "== Bouc-Wen: smoothness n x integrator"
 /usr/bin/python3 "$root/benchmarks/stability/bouc_wen_smoothness.py" "$build" "${quick[@]}" --output "$out"
+echo "== adaptive integrator: error against its tolerance at large increments"
+/usr/bin/python3 "$root/benchmarks/stability/adaptive_tolerance.py" "$build" "${quick[@]}" --output "$out"
 echo "== time step: 0.1 to 2.5 x the critical step"
 /usr/bin/python3 "$root/benchmarks/stability/time_step_sweep.py" "$build" "${quick[@]}" --output "$out/time_step"
 echo "== extreme but valid inputs"

@@ -400,6 +400,16 @@ namespace hysteron
                   inv_scale,
                   max_substeps,
                   [&](const Vector &x) { return rates_w(x, d); },
+                  // lambda = n |plastic rate| / Phi, the plastic rate d - w'.
+                  [&](const Vector &x, const Vector &f) {
+                    const double phi2 = dot(x, x);
+                    if (!(phi2 > 0))
+                      return 0.0;
+                    Vector p;
+                    for (unsigned int i = 0; i < 3; ++i)
+                      p[i] = d[i] - f[i];
+                    return n * std::sqrt(dot(p, p) / phi2);
+                  },
                   [&](Vector &x) {
                     // Back into the invariant ball Phi <= Phi_s (radial = closest point).
                     const double phi = std::sqrt(dot(x, x));

@@ -965,6 +965,43 @@ namespace hysteron
 
 
     template <int dim>
+    template <typename Fail>
+    void
+    Solver<dim>::check_energy(const double t, const double dt, const double critical, Fail &&fail_at_t)
+    {
+      // Divergence: in a physical motion the kinetic energy plus the internal work (strain
+      // energy + dissipation) of the deformable points equals the energy put in (their
+      // initial kinetic energy plus the work of gravity, loads, prescribed boundaries and
+      // rigid bodies). An unstable step (too large for the grid, or points in cells whose
+      // nodes carry little mass) grows it without bound while the values stay finite for
+      // many steps; stop at twice the input, as the explicit FEM does (stable runs stay
+      // within a few per cent of it). One sum per step, an MPI reduction only on several ranks.
+      std::array<double, 4> sums{{kinetic_energy, internal_work, std::abs(external_work), boundary_work}};
+      if (grid->is_parallel())
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(sums.data(), sums.size()),
+                                    grid->mpi_communicator(),
+                                    dealii::ArrayView<double>(sums.data(), sums.size()));
+      const double input = initial_kinetic_energy + sums[2] + std::abs(sums[3]);
+      if (input > 0 && sums[0] + sums[1] > 2 * input)
+        {
+          std::ostringstream m;
+          m << "mpm: the explicit scheme diverged in the step from t = " << t << " s (step "
+            << n_steps + 1 << ", time step " << dt << " s = " << dt / critical
+            << " times the critical step h / max_p(c_p + |v_p|) = " << critical
+            << " s): the kinetic energy plus the internal work " << sums[0] + sums[1]
+            << " J is more than twice the energy put in (" << input
+            << " J: initial kinetic energy, work of gravity, loads, boundaries and rigid bodies). "
+            << "Reduce Time/CFL factor or Time/Time step; with the linear basis, points crossing "
+            << "into cells whose nodes carry little mass also cause this (a finer point "
+            << "spacing or the cubic B-spline basis helps). The last good state (t = " << t
+            << " s) was written.";
+          fail_at_t(m.str());
+        }
+    }
+
+
+
+    template <int dim>
     void
     Solver<dim>::run()
     {
@@ -1001,6 +1038,13 @@ namespace hysteron
 
       double t = 0;
       internal_work = external_work = boundary_work = 0;
+      initial_kinetic_energy = 0;
+      for (const auto &group : particles.groups)
+        if (group.material != nullptr)
+          for (unsigned int p = group.begin; p < group.end; ++p)
+            initial_kinetic_energy += 0.5 * particles.mass[p] * particles.current.v[p].norm_square();
+      if (grid->is_parallel())
+        initial_kinetic_energy = dealii::Utilities::MPI::sum(initial_kinetic_energy, grid->mpi_communicator());
       write_fields(t);
       write_table_rows(t);
       PointData::Schedule rows(probe_interval, time.end_time), fields(scene.output_control().interval, time.end_time);
@@ -1028,6 +1072,16 @@ namespace hysteron
           dt            = std::min(dt, time.end_time - t);
           step_critical = critical;
           step_dt       = dt;
+          // The work sums and reactions of the state t: a failed step leaves them so.
+          const std::array<double, 3> work_at_t{{internal_work, external_work, boundary_work}};
+          const auto                  reactions_at_t = reactions;
+          const auto                  fail_at_t      = [&](const std::string &what) {
+            internal_work = work_at_t[0];
+            external_work = work_at_t[1];
+            boundary_work = work_at_t[2];
+            reactions     = reactions_at_t;
+            fail(what, t);
+          };
           {
             dealii::TimerOutput::Scope timing(scene.timer(), "steps");
             if (basis_name == "linear")
@@ -1039,7 +1093,8 @@ namespace hysteron
           if (grid->is_parallel())
             failed = dealii::Utilities::MPI::logical_or(failed, grid->mpi_communicator());
           if (failed)
-            fail(describe_failure(t), t);
+            fail_at_t(describe_failure(t));
+          check_energy(t, dt, critical, fail_at_t);
           particles.commit();
           t += dt;
           ++n_steps;

@@ -783,3 +783,34 @@ TEST(BoucWenUniaxial, ForwardEulerInstabilityIsAnError)
   EXPECT_THROW(drive(BoucWenUniaxial(parameters(32, BoucWenIntegrator::forward_euler), E), eps),
                hysteron::RuntimeError);
 }
+
+
+
+// One large increment from any state of the knee meets the tolerance: the whole increment
+// used to be accepted on an accidentally small 3(2) estimate where h lambda ~ 1 (lambda =
+// n |plastic rate| / |z|), 450 times the tolerance at n = 2, z/z_y = 0.9866, deps = z_y / 2
+// (doc/stability/bouc_wen.md). Reference: the same increment at tolerance 1e-12.
+TEST(BoucWenUniaxial, AdaptiveMeetsToleranceForLargeIncrementsInTheKnee)
+{
+  const double tolerance = 1e-6;
+  for (const double n : {1.0, 2.0, 4.0, 8.0})
+    {
+      const BoucWenUniaxial law(parameters(n, BoucWenIntegrator::adaptive, tolerance), E);
+      const BoucWenUniaxial reference(parameters(n, BoucWenIntegrator::adaptive, 1e-12), E);
+      double worst = 0;
+      for (const double z0 : {0.0, 0.5, 0.8, 0.9, 0.95, 0.9866, 0.995, -0.5, -0.9866})
+        for (const double dx : {0.125, 0.25, 0.5, 1.0, 2.0})
+          {
+            std::array<double, 3> s{{0, 1, 0}}, s_ref;
+            law.initialize_state(s.data());
+            s[0]         = z0 * z_y;
+            s_ref        = s;
+            double sigma = 0, sigma_ref = 0;
+            law.update(dx * z_y, sigma, s.data());
+            reference.update(dx * z_y, sigma_ref, s_ref.data());
+            worst = std::max(worst, std::abs(s[0] - s_ref[0]) / z_y);
+          }
+      std::cout << "  n = " << n << ": largest error / tolerance " << worst / tolerance << std::endl;
+      EXPECT_LT(worst, 3 * tolerance) << "n = " << n;
+    }
+}

@@ -115,7 +115,9 @@ namespace hysteron
      *   max |err_i| / scale_i with scales sigma_y0 (stresses), eps_y (strains),
      *   sigma_y0 eps_y (e_h), step factor 0.9 (tol/err)^(1/3) in [0.2, 5]; a
      *   non-finite trial step (overflow of (q/sigma_y)^n in a too long step) is
-     *   shortened; at most Constants::max_substeps attempts, then RuntimeError. At
+     *   shortened; an accepted step must also pass the second estimate of
+     *   stiff_error(), since the 3(2) difference can be small by accident in the knee
+     *   (bogacki_shampine_32()); at most Constants::max_substeps attempts, then RuntimeError. At
      *   the end of the increment a drift correction (see drift_correction()) keeps
      *   nu_s H1 <= 1 (exact solutions do), which an explicit method near its stability
      *   limit on the stiff relaxation towards q = sigma_y otherwise misses by a few
@@ -875,6 +877,30 @@ namespace hysteron
         }
 
         /**
+         * The second error estimate of a step (bogacki_shampine_32() derives it): in the
+         * knee the 3(2) difference can be small by accident, while the error of q is about
+         * (h lambda)^3 / 24 |q_1 - q_0|, the distance to the yield surface decaying like
+         * exp(-lambda s). lambda = n |q'_plastic| / q with
+         * the plastic rate of q 3 mu |eps_ps'| at q ~ sigma_y, and |q_1 - q_0| ~ sigma_y
+         * |H1_1 - H1_0| / n there (H1 = (q / sigma_y)^n): no false alarm while the stress
+         * flows along the surface. @p k1, @p k4: the rates at the two ends.
+         */
+        static inline double
+        stiff_error(const Constants &c,
+                    const double     h,
+                    const VecN      &y,
+                    const VecN      &k1,
+                    const VecN      &k4,
+                    const double     H1_0,
+                    const double     H1_1)
+        {
+          const double hl = h * c.n * 1.5 * c.two_mu *
+                            std::max(k1[i_eps_ps], k4[i_eps_ps]) /
+                            (c.sigma_y0 + c.iso * y[i_eps_ps]);
+          return hl * hl * hl / 24 * std::abs(H1_1 - H1_0) / c.n * c.inv_tol;
+        }
+
+        /**
          * The sub-step loop of adaptive() from s = 0 with the trial step @p h,
          * k1 = f(y) and @p attempts attempts already spent (by a rejected first
          * attempt of adaptive_points()). See adaptive().
@@ -936,6 +962,10 @@ namespace hysteron
                     }
                   h *= 0.1;
                 }
+              else if (const double es =
+                         (e <= 1.0 ? stiff_error(c, h, y, k1, k4, H1_now, H1_new) : 0.0);
+                       es > 1.0)
+                h *= std::max(0.2, 0.9 / std::sqrt(std::sqrt(es)));
               else if (e <= 1.0)
                 {
                   y      = y_new;
@@ -1031,8 +1061,13 @@ namespace hysteron
           stage(yt, k4);
           for (unsigned int p = 0; p < P; ++p)
             {
-              const double e = bs32_error(c, 1.0, k1[p], k2[p], k3[p], k4[p]);
-              if (e <= 1.0)
+              const double e  = bs32_error(c, 1.0, k1[p], k2[p], k3[p], k4[p]);
+              const double es =
+                e <= 1.0 ? stiff_error(c, 1.0, y[p], k1[p], k4[p], H1[p], st[p].H1) : 0.0;
+              if (es > 1.0)
+                substeps(c, y[p], De[p], k1[p], H1[p],
+                         std::max(0.2, 0.9 / std::sqrt(std::sqrt(es))), 1, r[p], false);
+              else if (e <= 1.0)
                 {
                   y[p] = yt[p];
                   finish(c, y[p], De[p], st[p], r[p], false);

@@ -578,6 +578,11 @@ namespace hysteron
         inv_scale,
         max_substeps,
         [&](const V &w) { return rates<degrading_>(w, deps); },
+        // lambda = n |plastic rate| / |z|: the plastic rate is deps / eta - z'.
+        [&](const V &w, const V &f) {
+          const double eta = degrading_ ? w[1] : 1.0;
+          return w[0] != 0 ? n * std::abs(deps / eta - f[0]) / std::abs(w[0]) : 0.0;
+        },
         project,
         [&]() { throw_too_many_substeps(deps, v[0]); });
     }

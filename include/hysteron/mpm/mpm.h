@@ -149,6 +149,10 @@ namespace hysteron
       /// The failure of the last step, described on every rank (from the rank that saw it).
       std::string
       describe_failure(const double t) const;
+      /// Stops the run (through @p fail_at_t) if the step from @p t diverged (energy).
+      template <typename Fail>
+      void
+      check_energy(const double t, const double dt, const double critical, Fail &&fail_at_t);
       void
       apply_boundary_conditions(const double t, const double dt, const bool record_reactions);
       bool
@@ -214,6 +218,8 @@ namespace hysteron
       double       internal_work        = 0; ///< sum V sigma : d eps (this rank)
       double       external_work        = 0; ///< gravity and loads (this rank)
       double       boundary_work        = 0; ///< reactions times prescribed velocities (owned nodes)
+      double       kinetic_energy       = 0; ///< of the deformable points after the step (this rank)
+      double       initial_kinetic_energy = 0; ///< of the deformable points at t = 0 (all ranks)
       std::vector<dealii::Tensor<1, dim>> reactions; ///< per boundary, then per rigid body
       long         failed_point         = -1;
       std::string  failure;

@@ -247,6 +247,7 @@ namespace hysteron
       // 3. G2P: velocities (FLIP/PIC blend) and positions.
       const double alpha = flip_fraction;
       max_speed          = 0;
+      kinetic_energy     = 0;
       for (const auto &group : particles.groups)
         {
           if (group.material == nullptr)
@@ -266,7 +267,7 @@ namespace hysteron
               max_speed = std::max(max_speed, v_end.norm());
               continue;
             }
-          double  group_max_speed = 0;
+          double  group_max_speed = 0, group_kinetic = 0;
           Support support;
           for (unsigned int p = group.begin; p < group.end; ++p)
             {
@@ -284,6 +285,7 @@ namespace hysteron
               nxt.v[p]                   = v_new;
               nxt.x[p]                   = cur.x[p] + dt * v_pic;
               group_max_speed            = std::max(group_max_speed, v_new.norm_square());
+              group_kinetic += particles.mass[p] * v_new.norm_square();
               const Tensor<1, dim> f_ext =
                 particles.mass[p] * gravity +
                 particles.load_factor[p] * load_per_point[particles.load[p]];
@@ -291,6 +293,7 @@ namespace hysteron
               track_cell(p, nxt.x[p]);
             }
           max_speed = std::max(max_speed, group.wave_speed + std::sqrt(group_max_speed));
+          kinetic_energy += 0.5 * group_kinetic;
         }
       if (!(max_speed < std::numeric_limits<double>::max()))
         for (unsigned int p = 0; p < particles.size() && failed_point < 0; ++p)
