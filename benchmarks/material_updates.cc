@@ -3,6 +3,7 @@
 //
 //   benchmarks/material_updates [--repeats 5] [--points 1000] [--csv FILE]
 //                               [--only "plane stress/adaptive/8"]  (one case, no reference)
+//                               [--sweep FILE]  (error against cost, written to FILE)
 //
 // For every stress state (plane stress, plane strain, 3D), Bouc-Wen integrator (forward Euler,
 // adaptive, backward Euler) and smoothness n in {2, 8, 32}, a batch of points follows the path
@@ -11,6 +12,14 @@
 // measured (median of the repeats). The error is max_t |sigma - sigma_ref| / sigma_y, where the
 // reference integrates the same piecewise-linear path with the adaptive integrator at tolerance
 // 1e-12. Hooke's law is measured as the floor. Output: a Markdown table on stdout and a CSV.
+//
+// --sweep: error against cost at n = 8 for the smooth path itself, so that the increment size
+// counts: forward and backward Euler at 150 ... 9600 increments per cycle, the adaptive
+// integrator at tolerances 1e-2 ... 1e-8 and 150 ... 2400 increments per cycle. The error is
+// max |sigma - sigma_ref| / sigma_y over the 300 states at t = k/150, against the adaptive
+// integrator at tolerance 1e-12 with 150 * 1024 increments per cycle (the piecewise-linear
+// path then differs from the sinusoids by O((2 pi / 153600)^2)); the cost is the wall time of
+// the update loop per point and cycle (median of the repeats).
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/timer.h>
@@ -165,6 +174,51 @@ namespace
       }
     return result;
   }
+
+  /// One row of the --sweep: the run's stress at t = k/150 against the reference's.
+  template <int dim>
+  void
+  sweep_state(const std::string &state, const unsigned int points, const unsigned int repeats,
+              hysteron::Output::CsvWriter &csv, const double dim_id, const double ps_id)
+  {
+    constexpr unsigned int coarsest = 150, refinement = 1024;
+    Case                   c{state, "bouc-wen", "adaptive", 8};
+    double                 ignored = 0;
+    const auto             ref =
+      run_path<dim>(*make_material<dim>(c, 1e-12), 1, coarsest * refinement, ignored);
+
+    const auto run = [&](const std::string &integrator, const double tolerance,
+                         const unsigned int steps_per_cycle) {
+      c.integrator        = integrator;
+      const auto material = make_material<dim>(c, tolerance);
+      std::vector<double>                  times;
+      std::vector<SymmetricTensor<2, dim>> history;
+      for (unsigned int r = 0; r < repeats; ++r)
+        {
+          double seconds = 0;
+          history        = run_path<dim>(*material, points, steps_per_cycle, seconds);
+          times.push_back(seconds);
+        }
+      std::sort(times.begin(), times.end());
+      const unsigned int stride = steps_per_cycle / coarsest;
+      double             error  = 0;
+      for (unsigned int k = 1; k <= 2 * coarsest; ++k)
+        error = std::max(error,
+                         (history[k * stride - 1] - ref[k * refinement - 1]).norm() / sigma_y);
+      const double integrator_id =
+        integrator == "forward euler" ? 1 : (integrator == "adaptive" ? 2 : 3);
+      csv.add_row({dim_id, ps_id, integrator_id, tolerance, double(steps_per_cycle),
+                   times[times.size() / 2] / points / 2, error});
+      std::cout << state << ", " << integrator << ", tolerance " << tolerance << ", "
+                << steps_per_cycle << " increments per cycle: error " << error << std::endl;
+    };
+    for (const std::string integrator : {"forward euler", "backward euler"})
+      for (const unsigned int steps : {150u, 300u, 600u, 1200u, 2400u, 4800u, 9600u})
+        run(integrator, 1e-6, steps);
+    for (const double tolerance : {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-8})
+      for (const unsigned int steps : {150u, 600u, 2400u})
+        run("adaptive", tolerance, steps);
+  }
 } // namespace
 
 int
@@ -174,6 +228,7 @@ main(int argc, char **argv)
   unsigned int repeats = 5, points = 1000, steps_per_cycle = 600;
   std::string  csv_file = "material_updates.csv";
   std::string  only; // "state/integrator/n": time this case alone (profiling), no error
+  std::string  sweep_file; // error against cost (see the header)
   for (int i = 1; i + 1 < argc; i += 2)
     {
       const std::string a = argv[i];
@@ -187,10 +242,12 @@ main(int argc, char **argv)
         csv_file = argv[i + 1];
       else if (a == "--only")
         only = argv[i + 1];
+      else if (a == "--sweep")
+        sweep_file = argv[i + 1];
       else
         {
           std::cerr << "usage: material_updates [--repeats R] [--points P] [--steps S] [--csv F]"
-                       " [--only 'state/integrator/n']\n";
+                       " [--only 'state/integrator/n'] [--sweep F]\n";
           return 1;
         }
     }
@@ -211,6 +268,18 @@ main(int argc, char **argv)
         run_path<2>(*make_material<2>(c, 1e-6), points, steps_per_cycle, seconds);
       std::cout << only << ": " << double(points) * 2 * steps_per_cycle / seconds / 1e6
                 << " M updates/s" << std::endl;
+      return 0;
+    }
+
+  if (!sweep_file.empty())
+    {
+      hysteron::Output::CsvWriter sweep(sweep_file,
+                                        {"dim", "plane_stress", "integrator", "tolerance",
+                                         "steps_per_cycle", "seconds_per_point_cycle", "error"});
+      sweep_state<2>("plane stress", points, repeats, sweep, 2, 1);
+      sweep_state<2>("plane strain", points, repeats, sweep, 2, 0);
+      sweep_state<3>("3D", points, repeats, sweep, 3, 0);
+      sweep.commit();
       return 0;
     }
 

@@ -22,7 +22,7 @@ cases compare a scene against the same scene with one feature switched on or off
   * fracture: off against on with strengths that are never reached (the cost of the check);
     and the instructions in the fracture functions when off.
 
-Writes doc/benchmarks/pay_for_use.md. Usage: benchmarks/pay_for_use.py BUILD_DIR
+Writes OUT/pay_for_use.md (OUT = doc/benchmarks). Usage: benchmarks/pay_for_use.py BUILD_DIR [--out OUT]
 """
 import os
 import re
@@ -178,7 +178,10 @@ def main():
                      f"{100 * (b / a - 1):+.2f} % |")
     lines += ["", f"MPI on one rank: {mpi_steps:,} instructions in MPI functions inside the time steps; "
               f"{mpi_run:,} in MPI_Allreduce and MPI_Bcast over the whole run (set-up and output).", ""]
-    out = os.path.join(ROOT, "doc", "benchmarks", "pay_for_use.md")
+    out_dir = (sys.argv[sys.argv.index("--out") + 1] if "--out" in sys.argv
+               else os.path.join(ROOT, "doc", "benchmarks"))
+    os.makedirs(out_dir, exist_ok=True)
+    out = os.path.join(out_dir, "pay_for_use.md")
     with open(out, "w") as f:
         f.write("\n".join(lines))
     print("\n".join(lines))

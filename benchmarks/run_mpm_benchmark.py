@@ -9,9 +9,9 @@
 
 The time is the `steps` section of hysteron's timer table (set-up and output excluded), the
 median of --repeats runs. Memory per point: (peak RSS of the run - peak RSS of the same scene
-with a single-cell block) / points. Writes doc/benchmarks/mpm_throughput.md.
+with a single-cell block) / points. Writes OUT/mpm_throughput.md (OUT = doc/benchmarks).
 
-Usage: run_mpm_benchmark.py BUILD_DIR [--repeats 3] [--mpiexec mpirun]
+Usage: run_mpm_benchmark.py BUILD_DIR [--repeats 3] [--mpiexec mpirun] [--out OUT]
 """
 import os
 import re
@@ -60,6 +60,8 @@ def main():
     build = os.path.abspath(sys.argv[1])
     repeats = int(sys.argv[sys.argv.index("--repeats") + 1]) if "--repeats" in sys.argv else 3
     mpiexec = sys.argv[sys.argv.index("--mpiexec") + 1] if "--mpiexec" in sys.argv else "mpirun"
+    out_dir = (sys.argv[sys.argv.index("--out") + 1] if "--out" in sys.argv
+               else os.path.join(ROOT, "doc/benchmarks"))
     hysteron = os.path.join(build, "hysteron")
     rows = []
     with tempfile.TemporaryDirectory() as work:
@@ -87,15 +89,15 @@ def main():
     cpu = open("/proc/cpuinfo").read()
     model = re.search(r"model name\s*:\s*(.*)", cpu).group(1)
     out = [f"Machine: {os.cpu_count()} cores, {model}; Release build; median of {repeats} runs; "
-           f"command: benchmarks/run_mpm_benchmark.py build", "",
+           f"command: benchmarks/run_mpm_benchmark.py BUILD_DIR --repeats {repeats}", "",
            "| scene | points | steps | time of the steps [s] | M particle-steps/s/core | "
            "memory per point [B] | 2-rank efficiency |", "|---|---|---|---|---|---|---|"]
     for name, p, s, t, rate, mem, eff in rows:
         out.append(f"| {name} | {p} | {s} | {t:.3f} | {rate:.2f} | {mem:.0f} | {eff:.2f} |")
     text = "\n".join(out) + "\n"
     print(text)
-    os.makedirs(os.path.join(ROOT, "doc/benchmarks"), exist_ok=True)
-    with open(os.path.join(ROOT, "doc/benchmarks/mpm_throughput.md"), "w") as f:
+    os.makedirs(out_dir, exist_ok=True)
+    with open(os.path.join(out_dir, "mpm_throughput.md"), "w") as f:
         f.write(text)
 
 
