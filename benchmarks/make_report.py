@@ -33,15 +33,16 @@ skipped) to check the pipeline in a few minutes; its report is not for committin
 Usage: benchmarks/make_report.py BUILD_DIR [--repeats 3] [--lanes 1|2] [--quick]
                                  [--only a,b] [--report-only] [--out DIR] [--doc FILE]
   --only: run only these studies and take the others' results from OUT as they are
-  --report-only: run nothing, rebuild doc/benchmarks.md and the fronts from OUT's CSVs
+  --report-only: run nothing, rebuild doc/benchmarks.md and the fronts from OUT's CSVs and
+                 OUT/report_run.json (date, commit, load and study times of the last full run)
 """
 import argparse
 import concurrent.futures
 import csv
 import datetime
+import json
 import math
 import os
-import platform
 import re
 import subprocess
 import sys
@@ -51,7 +52,7 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "benchmarks"))
-from report_template import fill, write_atomically  # noqa: E402
+from report_template import environment, fill, write_atomically  # noqa: E402
 
 PY = "/usr/bin/python3"          # Debian's matplotlib lives here
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
@@ -231,11 +232,13 @@ def collect(out):
 
     rows = read_csv(out, "mpm_scheme_time_step.csv")
     vb = scene("vibrating_bar", "MPM vibrating bar (first axial mode)", "the analytic mode",
-               "max |u_x − u_exact| / amplitude at the tip", "s (steps)", 1e-2, "mpm_scheme_time_step")
+               "max |u_x − u_exact| / amplitude at the tip", "s (steps)", 1e-2, "mpm_scheme_time_step",
+               note="front over the runs with CFL factor ≤ 0.8, a margin below the stability bound "
+                    "(the linear basis goes unstable inside it on fine grids)")
     for r in rows:
         vb.add(f"MPM {r['basis'].replace(' B-spline', '')}, {r['scheme']}",
-               f"h = {number(r['h']):g} m, CFL {number(r['cfl']):g}, {r['k']}x{r['k']}", number(r["time"]),
-               number(r["error"]), r["status"] == "ok")
+               f"h = {r['h_label']}, CFL {number(r['cfl']):g}, {r['k']}x{r['k']}", number(r["time"]),
+               number(r["error"]), r["status"] == "ok", number(r["cfl"]) <= 0.8)
 
     rows = read_csv(out, "fem_mpm_error_vs_time.csv")
     cantilever = scene("cantilever", "Elastic cantilever, FEM against MPM",
@@ -254,8 +257,11 @@ def collect(out):
     for r in rows:
         key = "fem_" + re.sub(r"[^a-z0-9]+", "_", (r["scene"] + " " + r["quantity"]).lower()).strip("_")
         if key not in scenes:
-            scene(key, f"{r['scene']}, FEM: {r['quantity']}", r.get("reference", "") or "see the study",
-                  f"|q − q_ref| / q_ref", "s (steps)", 1e-2, "fem_plastic_error_vs_time")
+            how = ("the independent elastic solution" if "stiffness" in r["quantity"]
+                   else "converged FEM, extrapolated in h and the increments")
+            scene(key, f"{r['scene']}, FEM: {r['quantity']}",
+                  f"{how}, q_ref = {number(r['q_ref']):.6g} (see the study)",
+                  "|q − q_ref| / q_ref", "s (steps)", 1e-2, "fem_plastic_error_vs_time")
         scenes[key].add(f"FEM Q{r['degree']}, {r['integrator']}",
                         f"h = {r['h']}, {r['increments']} inc.", number(r["time"]), number(r["error"]),
                         r["status"] == "ok")
@@ -443,31 +449,8 @@ def namespace(context):
 
 
 def machine_info(args, started, load_before, load_samples, selected):
-    cpu = re.search(r"model name\s*:\s*(.*)", open("/proc/cpuinfo").read())
-    memory = re.search(r"MemTotal:\s*(\d+)", open("/proc/meminfo").read())
-    cache = open(os.path.join(args.build, "CMakeCache.txt")).read()
-    build_type = re.search(r"CMAKE_BUILD_TYPE:STRING=(.*)", cache).group(1)
-    compiler = re.search(r"CMAKE_CXX_COMPILER:(?:FILEPATH|STRING)=(.*)", cache)
-    try:
-        compiler = subprocess.check_output([compiler.group(1), "--version"], text=True).splitlines()[0]
-    except (AttributeError, OSError, subprocess.CalledProcessError):
-        compiler = "unknown"
-    dealii = re.search(r'DEAL_II_PACKAGE_VERSION "([^"]+)"', open("/usr/include/deal.II/base/config.h").read())
-
-    def git(*a):
-        try:
-            return subprocess.check_output(["git", *a], cwd=ROOT, text=True).strip()
-        except (OSError, subprocess.CalledProcessError):
-            return "unknown"
-
-    dirty = git("status", "--porcelain", "--untracked-files=no")
-    debian = open("/etc/debian_version").read().strip() if os.path.exists("/etc/debian_version") else "?"
     return dict(
-        cpu=cpu.group(1).strip() if cpu else "unknown CPU", cores=os.cpu_count(),
-        memory=f"{int(memory.group(1)) / 2**20:.0f} GiB" if memory else "?",
-        os=f"Debian {debian}, {platform.system()} {platform.release()}", build_type=build_type,
-        compiler=compiler, dealii=dealii.group(1) if dealii else "?",
-        commit=git("rev-parse", "--short", "HEAD") + (" (with uncommitted changes)" if dirty else ""),
+        environment(args.build, ROOT),
         date=started.strftime("%Y-%m-%d %H:%M UTC"), repeats=args.repeats, lanes=args.lanes,
         command=" ".join(["benchmarks/make_report.py", *sys.argv[1:]]),
         load_before=load_before,
@@ -523,8 +506,20 @@ def main():
     scenes = collect(out)
     plot_fronts(scenes, os.path.join(out, "pareto_fronts.png"))
     info = machine_info(args, started, load_before, samples, selected)
+    run_file = os.path.join(out, "report_run.json")
     if args.report_only:
-        info["studies"] = "not rerun (--report-only: the studies' files in OUT as they are)"
+        # The run that measured the studies' files (written by the last full run).
+        if not os.path.exists(run_file):
+            raise SystemExit(f"make_report.py: --report-only needs {run_file} of a full run")
+        with open(run_file) as f:
+            measured = json.load(f)
+        info.update({k: measured[k] for k in ("date", "repeats", "lanes", "command", "load_before",
+                                              "load_during", "studies", "total", "commit")})
+        info["command"] += " (report rebuilt by --report-only)"
+    elif not only and not args.quick:
+        write_atomically(run_file, json.dumps({k: info[k] for k in (
+            "date", "repeats", "lanes", "command", "load_before", "load_during", "studies", "total",
+            "commit")}, indent=1))
     context = Context(scenes, out, info)
     text = fill(open(os.path.join(ROOT, "benchmarks", "benchmarks.md.in")).read(), namespace(context),
                 "make_report.py")

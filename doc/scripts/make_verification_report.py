@@ -37,7 +37,6 @@ import csv
 import datetime
 import math
 import os
-import platform
 import re
 import resource
 import shutil
@@ -49,7 +48,7 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "benchmarks"))
-from report_template import fill, write_atomically  # noqa: E402
+from report_template import environment, fill, write_atomically  # noqa: E402
 
 PY = "/usr/bin/python3"          # Debian's matplotlib lives here
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
@@ -377,35 +376,10 @@ def join(values, digits, separator=", "):
 
 
 def machine_info(args, started, jobs, command):
-    cpu = re.search(r"model name\s*:\s*(.*)", open("/proc/cpuinfo").read())
-    memory = re.search(r"MemTotal:\s*(\d+)", open("/proc/meminfo").read())
-    cache = open(os.path.join(args.build, "CMakeCache.txt")).read()
-    build_type = re.search(r"CMAKE_BUILD_TYPE:STRING=(.*)", cache)
-    compiler = re.search(r"CMAKE_CXX_COMPILER:(?:FILEPATH|STRING)=(.*)", cache)
-    try:
-        compiler = subprocess.check_output([compiler.group(1), "--version"], text=True).splitlines()[0]
-    except (AttributeError, OSError, subprocess.CalledProcessError):
-        compiler = "unknown"
-    config = "/usr/include/deal.II/base/config.h"
-    dealii = re.search(r'DEAL_II_PACKAGE_VERSION "([^"]+)"', open(config).read()) if os.path.exists(config) else None
-
-    def git(*a):
-        try:
-            return subprocess.check_output(["git", *a], cwd=ROOT, text=True).strip()
-        except (OSError, subprocess.CalledProcessError):
-            return "unknown"
-
-    dirty = git("status", "--porcelain", "--untracked-files=no")
-    debian = open("/etc/debian_version").read().strip() if os.path.exists("/etc/debian_version") else "?"
     scenes = [j for j in jobs if j.seconds is not None]
     return dict(
-        date=started.strftime("%Y-%m-%d %H:%M UTC"),
-        commit=git("rev-parse", "--short", "HEAD") + (" (with uncommitted changes)" if dirty else ""),
-        cpu=cpu.group(1).strip() if cpu else "unknown CPU", cores=os.cpu_count(),
-        memory=f"{int(memory.group(1)) / 2**20:.0f} GiB" if memory else "?",
-        os=f"Debian {debian}, {platform.system()} {platform.release()}",
-        build_type=build_type.group(1) if build_type else "?", compiler=compiler,
-        dealii=dealii.group(1) if dealii else "?", command=command,
+        environment(args.build, ROOT),
+        date=started.strftime("%Y-%m-%d %H:%M UTC"), command=command,
         runs=(f"{len(scenes)} runs ({len(SCENES)} scenes with their `# CHECK` lines, 2 studies, "
               f"{len(VARIANTS)} variants), all passed; {sum(j.seconds for j in scenes) / 60:.1f} min of run time, "
               f"{args.jobs} at a time pinned to core {args.core}; whole script {{minutes}} min wall, "

@@ -282,7 +282,11 @@ namespace hysteron
                   std::ostringstream m;
                   m << "Material point: the stress-free components did not converge at step "
                     << step << " (t = " << t << " s): residual " << residual << " Pa after " << it
-                    << " Newton iterations";
+                    << " Newton iterations (tolerance " << tolerance * E * scale
+                    << " Pa = Material point/Mixed control tolerance x E x max |eps|). An adaptive "
+                    << "material integrator changes its sub-steps between the iterations, so its "
+                    << "response is only piecewise smooth at the level of its Tolerance: raise the "
+                    << "Mixed control tolerance towards the material's Tolerance";
                   throw RuntimeError(m.str());
                 }
               for (unsigned int a = 0; a < n_free; ++a)
