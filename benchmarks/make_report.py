@@ -32,7 +32,8 @@ skipped) to check the pipeline in a few minutes; its report is not for committin
 
 Usage: benchmarks/make_report.py BUILD_DIR [--repeats 3] [--lanes 1|2] [--quick]
                                  [--only a,b] [--report-only] [--out DIR] [--doc FILE]
-  --only: run only these studies and take the others' results from OUT as they are
+  --only: run only these studies and take the others' results from OUT as they are (the
+          run record OUT/report_run.json then lists the rerun studies with their commit)
   --report-only: run nothing, rebuild doc/benchmarks.md and the fronts from OUT's CSVs and
                  OUT/report_run.json (date, commit, load and study times of the last full run)
 """
@@ -506,20 +507,25 @@ def main():
     scenes = collect(out)
     plot_fronts(scenes, os.path.join(out, "pareto_fronts.png"))
     info = machine_info(args, started, load_before, samples, selected)
+    # The record of the run that measured the studies' files: written by a full run, updated
+    # by --only (the studies it reran, with their commit), read by --report-only.
     run_file = os.path.join(out, "report_run.json")
-    if args.report_only:
-        # The run that measured the studies' files (written by the last full run).
+    keys = ("date", "repeats", "lanes", "command", "load_before", "load_during", "studies", "total", "commit")
+    if args.report_only or only:
         if not os.path.exists(run_file):
-            raise SystemExit(f"make_report.py: --report-only needs {run_file} of a full run")
+            raise SystemExit(f"make_report.py: --report-only and --only need {run_file} of a full run")
         with open(run_file) as f:
             measured = json.load(f)
-        info.update({k: measured[k] for k in ("date", "repeats", "lanes", "command", "load_before",
-                                              "load_during", "studies", "total", "commit")})
-        info["command"] += " (report rebuilt by --report-only)"
-    elif not only and not args.quick:
-        write_atomically(run_file, json.dumps({k: info[k] for k in (
-            "date", "repeats", "lanes", "command", "load_before", "load_during", "studies", "total",
-            "commit")}, indent=1))
+        if only and not args.quick:
+            reran = "; ".join(f"{s.name} {s.seconds / 60:.1f} min on {info['date']} at {info['commit']}"
+                              for s in selected)
+            measured["studies"] += f"; rerun with --only: {reran}"
+            write_atomically(run_file, json.dumps(measured, indent=1))
+        info.update({k: measured[k] for k in keys})
+        if args.report_only:
+            info["command"] += " (report rebuilt by --report-only)"
+    elif not args.quick:
+        write_atomically(run_file, json.dumps({k: info[k] for k in keys}, indent=1))
     context = Context(scenes, out, info)
     text = fill(open(os.path.join(ROOT, "benchmarks", "benchmarks.md.in")).read(), namespace(context),
                 "make_report.py")

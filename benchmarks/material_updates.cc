@@ -144,23 +144,35 @@ namespace
     return history;
   }
 
+  /// The median wall time of @p repeats runs of the path; @p history: point 0's stresses.
+  template <int dim>
+  double
+  median_time(const hysteron::Material::Interface<dim> &material,
+              const unsigned int                        points,
+              const unsigned int                        steps_per_cycle,
+              const unsigned int                        repeats,
+              std::vector<SymmetricTensor<2, dim>>     &history)
+  {
+    std::vector<double> times;
+    for (unsigned int r = 0; r < repeats; ++r)
+      {
+        double seconds = 0;
+        history        = run_path<dim>(material, points, steps_per_cycle, seconds);
+        times.push_back(seconds);
+      }
+    std::sort(times.begin(), times.end());
+    return times[times.size() / 2];
+  }
+
   template <int dim>
   Result
   measure(const Case &c, const unsigned int points, const unsigned int steps_per_cycle,
           const unsigned int repeats)
   {
-    const auto          material = make_material<dim>(c, 1e-6);
-    std::vector<double> times;
     std::vector<SymmetricTensor<2, dim>> history;
-    for (unsigned int r = 0; r < repeats; ++r)
-      {
-        double seconds = 0;
-        history        = run_path<dim>(*material, points, steps_per_cycle, seconds);
-        times.push_back(seconds);
-      }
-    std::sort(times.begin(), times.end());
-    Result result;
-    result.updates_per_second = double(points) * 2 * steps_per_cycle / times[times.size() / 2];
+    const double seconds = median_time<dim>(*make_material<dim>(c, 1e-6), points, steps_per_cycle, repeats, history);
+    Result       result;
+    result.updates_per_second = double(points) * 2 * steps_per_cycle / seconds;
 
     if (c.model != "linear elastic")
       {
@@ -189,17 +201,10 @@ namespace
 
     const auto run = [&](const std::string &integrator, const double tolerance,
                          const unsigned int steps_per_cycle) {
-      c.integrator        = integrator;
-      const auto material = make_material<dim>(c, tolerance);
-      std::vector<double>                  times;
+      c.integrator = integrator;
       std::vector<SymmetricTensor<2, dim>> history;
-      for (unsigned int r = 0; r < repeats; ++r)
-        {
-          double seconds = 0;
-          history        = run_path<dim>(*material, points, steps_per_cycle, seconds);
-          times.push_back(seconds);
-        }
-      std::sort(times.begin(), times.end());
+      const double                         seconds =
+        median_time<dim>(*make_material<dim>(c, tolerance), points, steps_per_cycle, repeats, history);
       const unsigned int stride = steps_per_cycle / coarsest;
       double             error  = 0;
       for (unsigned int k = 1; k <= 2 * coarsest; ++k)
@@ -208,7 +213,7 @@ namespace
       const double integrator_id =
         integrator == "forward euler" ? 1 : (integrator == "adaptive" ? 2 : 3);
       csv.add_row({dim_id, ps_id, integrator_id, tolerance, double(steps_per_cycle),
-                   times[times.size() / 2] / points / 2, error});
+                   seconds / points / 2, error});
       std::cout << state << ", " << integrator << ", tolerance " << tolerance << ", "
                 << steps_per_cycle << " increments per cycle: error " << error << std::endl;
     };
