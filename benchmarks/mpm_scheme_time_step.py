@@ -46,7 +46,6 @@ Usage: mpm_scheme_time_step.py BUILD_DIR [--repeats 3] [--quick] [--workdir /tmp
 import argparse
 import csv
 import datetime
-import importlib.util
 import math
 import os
 import re
@@ -54,18 +53,11 @@ import subprocess
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-
-def load_module(relative_path, name):
-    spec = importlib.util.spec_from_file_location(name, os.path.join(ROOT, relative_path))
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 # The shared helpers (timer table, repeats, Pareto front, machine and build lines, .prm editing).
-bench = load_module("benchmarks/mpm_error_vs_time.py", "mpm_error_vs_time")
+import mpm_error_vs_time as bench  # noqa: E402
+
+ROOT = bench.ROOT
 timers, repeat, mark_pareto = bench.timers, bench.repeat, bench.mark_pareto
 machine, build_info, with_entry, first_line = bench.machine, bench.build_info, bench.with_entry, bench.first_line
 ENV, LONG_RUN = bench.ENV, bench.LONG_RUN
