@@ -2,6 +2,7 @@
 #include <deal.II/base/utilities.h>
 #include <deal.II/particles/data_out.h>
 
+#include <hysteron/base/energy_check.h>
 #include <hysteron/base/exceptions.h>
 #include <hysteron/base/parameters.h>
 #include <hysteron/base/progress.h>
@@ -969,20 +970,16 @@ namespace hysteron
     void
     Solver<dim>::check_energy(const double t, const double dt, const double critical, Fail &&fail_at_t)
     {
-      // Divergence: in a physical motion the kinetic energy plus the internal work (strain
-      // energy + dissipation) of the deformable points equals the energy put in (their
-      // initial kinetic energy plus the work of gravity, loads, prescribed boundaries and
-      // rigid bodies). An unstable step (too large for the grid, or points in cells whose
-      // nodes carry little mass) grows it without bound while the values stay finite for
-      // many steps; stop at twice the input, as the explicit FEM does (stable runs stay
-      // within a few per cent of it). One sum per step, an MPI reduction only on several ranks.
+      // Divergence (energy_diverged()) of the deformable points: an unstable step, too large
+      // for the grid or with points in cells whose nodes carry little mass. One sum per
+      // step, an MPI reduction only on several ranks.
       std::array<double, 4> sums{{kinetic_energy, internal_work, std::abs(external_work), boundary_work}};
       if (grid->is_parallel())
         dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(sums.data(), sums.size()),
                                     grid->mpi_communicator(),
                                     dealii::ArrayView<double>(sums.data(), sums.size()));
       const double input = initial_kinetic_energy + sums[2] + std::abs(sums[3]);
-      if (input > 0 && sums[0] + sums[1] > 2 * input)
+      if (energy_diverged(sums[0] + sums[1], input))
         {
           std::ostringstream m;
           m << "mpm: the explicit scheme diverged in the step from t = " << t << " s (step "
@@ -1074,8 +1071,8 @@ namespace hysteron
           step_dt       = dt;
           // The work sums and reactions of the state t: a failed step leaves them so.
           const std::array<double, 3> work_at_t{{internal_work, external_work, boundary_work}};
-          const auto                  reactions_at_t = reactions;
-          const auto                  fail_at_t      = [&](const std::string &what) {
+          reactions_at_t = reactions; // a member: no allocation per step
+          const auto fail_at_t = [&](const std::string &what) {
             internal_work = work_at_t[0];
             external_work = work_at_t[1];
             boundary_work = work_at_t[2];

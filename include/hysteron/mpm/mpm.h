@@ -221,6 +221,7 @@ namespace hysteron
       double       kinetic_energy       = 0; ///< of the deformable points after the step (this rank)
       double       initial_kinetic_energy = 0; ///< of the deformable points at t = 0 (all ranks)
       std::vector<dealii::Tensor<1, dim>> reactions; ///< per boundary, then per rigid body
+      std::vector<dealii::Tensor<1, dim>> reactions_at_t; ///< of the state t during a step
       long         failed_point         = -1;
       std::string  failure;
       unsigned int n_changed_cells      = 0;
