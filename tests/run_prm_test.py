@@ -9,8 +9,9 @@ The scene runs in a fresh working directory (relative output paths land there) w
   # CHECK-COLUMNS <file>: <expr>  holds once, each column bound to the list of its values
   # EXPECT-ERROR: <regex>         the run must fail (exit status 1, or the one of EXIT),
                                   stderr must match <regex>, and no output file may be
-                                  left behind (no *.tmp, no CSV, no VTU; with EXIT: 2, a run
-                                  that failed, complete files of the last good state may stay)
+                                  left behind (exit 1: nothing at all, not even parameters.prm
+                                  or a manifest; with EXIT: 2, a run that failed, complete files
+                                  of the last good state may stay, but no *.tmp)
   # EXIT: <n>                     the expected non-zero exit status (with EXPECT-ERROR)
   # EXPECT-STDERR: <regex>        stderr must match (e.g. a warning) on a successful run
   # EXPECT-STDOUT: <regex>        stdout must match on a successful run
@@ -152,7 +153,7 @@ def main():
         # Bad input (exit 1) writes nothing; a run that fails (exit 2) keeps its last good
         # state, complete files only.
         left = [f for f in output_files(args.workdir)
-                if f != os.path.basename(prm) and not f.endswith("parameters.prm") and f not in inputs
+                if f != os.path.basename(prm) and f not in inputs
                 and (expected_code == 1 or f.endswith(".tmp"))]
         if left:
             failures.append(f"output files left behind after a failed run: {left}")

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Plot columns of hysteron CSV outputs (history.csv, probes.csv) as a PNG.
+"""Plot columns of hysteron CSV outputs (history.csv, probe_<i>.csv, energy.csv, ...) as a PNG.
 
   plot_history.py --x eps_xx --y sig_xx --xscale 100 --yscale 1e-6 \
       --xlabel "strain [%]" --ylabel "stress [MPa]" --out doc/figures/loop.png \

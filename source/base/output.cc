@@ -2,13 +2,18 @@
 
 #include <hysteron/base/exceptions.h>
 #include <hysteron/base/output.h>
+#include <hysteron/base/run_record.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <iomanip>
 #include <sstream>
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace hysteron
@@ -65,6 +70,7 @@ namespace hysteron
           throw RuntimeError("cannot write '" + final_name + "': " + std::strerror(errno));
         }
       committed = true;
+      RunRecord::get().add_file(final_name);
     }
 
     void
@@ -75,29 +81,141 @@ namespace hysteron
       file.commit();
     }
 
+    std::string
+    format_row(const std::vector<double> &values)
+    {
+      std::string row;
+      char        number[32];
+      for (std::size_t i = 0; i < values.size(); ++i)
+        {
+          if (i > 0)
+            row += ',';
+          // %.15g: 15 significant digits; + 0.0 prints -0 as 0.
+          const int n = std::snprintf(number, sizeof(number), "%.15g", values[i] + 0.0);
+          row.append(number, n);
+        }
+      row += '\n';
+      return row;
+    }
+
+    namespace
+    {
+      std::string
+      header_line(const std::vector<std::string> &columns)
+      {
+        std::string line;
+        for (std::size_t i = 0; i < columns.size(); ++i)
+          line += (i == 0 ? "" : ",") + columns[i];
+        return line + '\n';
+      }
+
+      void
+      check_row(const std::vector<double> &values, const std::size_t n_columns)
+      {
+        if (values.size() != n_columns)
+          throw std::logic_error("a table row of " + std::to_string(values.size()) +
+                                 " values for " + std::to_string(n_columns) + " columns");
+      }
+
+      double
+      wall_seconds()
+      {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+          .count();
+      }
+    } // namespace
+
     CsvWriter::CsvWriter(const std::string &filename, const std::vector<std::string> &columns)
       : columns(columns)
       , file(filename)
     {
-      for (std::size_t i = 0; i < columns.size(); ++i)
-        file.stream() << (i == 0 ? "" : ",") << columns[i];
-      file.stream() << '\n' << std::setprecision(15);
+      file.stream() << header_line(columns);
     }
 
     void
     CsvWriter::add_row(const std::vector<double> &values)
     {
-      if (values.size() != columns.size())
-        throw std::logic_error("CsvWriter: a row of " + std::to_string(values.size()) +
-                               " values for " + std::to_string(columns.size()) + " columns");
-      auto &out = file.stream();
-      for (std::size_t i = 0; i < values.size(); ++i)
+      check_row(values, columns.size());
+      file.stream() << format_row(values);
+    }
+
+    TimeTable::TimeTable(const std::string &filename, const std::vector<std::string> &columns)
+      : name(filename)
+      , n_columns_(columns.size())
+      , last_flush(wall_seconds())
+    {
+      auto              &record = RunRecord::get();
+      const std::int64_t keep   = record.resume_size(record.relative(filename));
+      if (keep >= 0)
         {
-          if (i > 0)
-            out << ',';
-          out << values[i] + 0.0; // + 0.0 prints -0 as 0
+          // Resume: the rows up to the checkpoint stay, the rest is cut off.
+          fd = ::open(filename.c_str(), O_WRONLY | O_CLOEXEC);
+          if (fd < 0 || ::ftruncate(fd, keep) != 0 || ::lseek(fd, keep, SEEK_SET) != keep)
+            throw RuntimeError("cannot resume the table '" + filename +
+                               "' (it should have at least " + std::to_string(keep) +
+                               " bytes from the checkpoint): " + std::strerror(errno));
+          written = keep;
         }
-      out << '\n';
+      else
+        {
+          fd = ::open(filename.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+          if (fd < 0)
+            throw RuntimeError("cannot open '" + filename + "' for writing: " +
+                               std::strerror(errno));
+          buffer = header_line(columns);
+        }
+      record.add_file(filename);
+      record.register_table(this);
+    }
+
+    TimeTable::~TimeTable()
+    {
+      RunRecord::get().unregister_table(this);
+      try
+        {
+          flush();
+        }
+      catch (...)
+        {
+          // A destructor must not throw; the error was reported by the run.
+        }
+      if (fd >= 0)
+        ::close(fd);
+    }
+
+    void
+    TimeTable::add_row(const std::vector<double> &values)
+    {
+      check_row(values, n_columns_);
+      buffer += format_row(values);
+      if (buffer.size() > (1u << 16))
+        flush();
+      else
+        {
+          const double now = wall_seconds();
+          if (now - last_flush > 0.5)
+            flush();
+        }
+    }
+
+    void
+    TimeTable::flush()
+    {
+      last_flush = wall_seconds();
+      // The buffer holds whole rows only: one write() per flush keeps the file at a
+      // row boundary whatever happens to the process.
+      std::size_t done = 0;
+      while (done < buffer.size())
+        {
+          const ssize_t n = ::write(fd, buffer.data() + done, buffer.size() - done);
+          if (n < 0 && errno == EINTR)
+            continue;
+          if (n <= 0)
+            throw RuntimeError("cannot write '" + name + "': " + std::strerror(errno));
+          done += n;
+        }
+      written += buffer.size();
+      buffer.clear();
     }
 
     FieldWriter::FieldWriter(const std::string &directory,
@@ -158,6 +276,11 @@ namespace hysteron
       times_and_names.emplace_back(time, record);
       if (rank == 0)
         {
+          // The pieces of the other ranks belong to this run too.
+          if (n_ranks > 1)
+            for (unsigned int r = 1; r < n_ranks; ++r)
+              RunRecord::get().add_file(directory + "/" + stem + "." +
+                                        dealii::Utilities::int_to_string(r, 4) + ".vtu");
           AtomicFile file(directory + "/" + base_name + ".pvd");
           dealii::DataOutBase::write_pvd_record(file.stream(), times_and_names);
           file.commit();

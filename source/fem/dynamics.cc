@@ -329,10 +329,10 @@ namespace hysteron
       v_half.compress(VectorOperation::insert);
 
       // The members keep the state of t until the step has passed its checks: a failing
-      // step writes the tables of t (fail()), not a mixture with the failed step (its
+      // step writes the tables of t (StepFailure), not a mixture with the failed step (its
       // velocity and acceleration are not yet assigned; the reactions are the converged
       // reaction_old, not the f_int and f_ext that assemble() overwrites).
-      const auto fail_step = [&](const std::string &what) { fail(what, t); };
+      const auto fail_step = [&](const std::string &what) { throw Run::StepFailure(what); };
       Vector ghost(owned_dofs, relevant_dofs, comm);
       ghost = u_trial;
       if (!assemble(ghost, t1, dt, Assemble::forces))

@@ -14,7 +14,6 @@
 
 #include <hysteron/base/newton.h>
 #include <hysteron/base/parameters.h>
-#include <hysteron/base/progress.h>
 #include <hysteron/fem/fem.h>
 #include <hysteron/geometry/mesh.h>
 
@@ -31,14 +30,6 @@ namespace hysteron
     namespace
     {
       const char *const *const component_names = PointData::component_names;
-
-      std::string
-      seconds(const double t)
-      {
-        std::ostringstream s;
-        s << std::setprecision(6) << t;
-        return s.str();
-      }
     } // namespace
 
 
@@ -903,24 +894,17 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::run()
+    Solver<dim>::setup()
     {
       const Scene<dim> &scene = this->get_scene();
       const auto       &time  = scene.time_control();
-      MPI_Comm          comm  = scene.mpi_communicator();
-      {
-        dealii::TimerOutput::Scope timing(scene.timer(), "set-up");
-        make_mesh();
-        setup_system();
-        setup_history();
-        setup_dirichlet();
-        setup_loads();
-        setup_probes();
-        setup_dynamics();
-        field_writer =
-          std::make_unique<Output::FieldWriter>(this->output_directory(), "fem", comm);
-        open_tables();
-      }
+      make_mesh();
+      setup_system();
+      setup_history();
+      setup_dirichlet();
+      setup_loads();
+      setup_probes();
+      setup_dynamics();
       const std::string analysis_name = analysis == Analysis::quasi_static      ? "quasi-static" :
                                         analysis == Analysis::implicit_dynamics ? "implicit dynamics" :
                                                                                   "explicit dynamics";
@@ -937,21 +921,36 @@ namespace hysteron
                      "converges linearly; Integrator = backward euler gives quadratic convergence"
                   << std::endl;
 
-      double t = 0;
-      write_fields(t);
-      write_table_rows(t);
-      PointData::Schedule rows(scene.output_control().probe_interval, time.end_time);
-      PointData::Schedule fields(scene.output_control().interval, time.end_time);
-      const double        eps = 1e-12 * time.end_time;
-      Progress progress(scene.console(), "fem", time.end_time, scene.output_control().progress_interval);
-
-      // The nominal step, and how often it has been halved.
+      // The nominal step (halved by the increment control when Newton fails).
       double nominal = fem_time_step > 0 ? fem_time_step : time.time_step;
-      if (analysis == Analysis::explicit_dynamics)
+      if (analysis == Analysis::explicit_dynamics && nominal == 0)
+        nominal = time.cfl_factor * critical_step;
+      else if (nominal == 0)
+        nominal = time.end_time / n_increments;
+      increments   = IncrementControl(nominal, newton.max_cuts);
+      step_checked = false;
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::open_outputs()
+    {
+      open_tables();
+    }
+
+
+
+    template <int dim>
+    double
+    Solver<dim>::propose_step(const double t)
+    {
+      if (analysis == Analysis::explicit_dynamics && !step_checked)
         {
-          if (nominal == 0)
-            nominal = time.cfl_factor * critical_step;
-          else if (nominal > maximum_cfl * critical_step)
+          step_checked = true;
+          const double nominal = increments.nominal();
+          if (nominal > maximum_cfl * critical_step)
             {
               std::ostringstream m;
               m << "fem: the time step " << nominal << " s is above the critical step "
@@ -959,80 +958,58 @@ namespace hysteron
                 << "FEM/Maximum CFL number = " << maximum_cfl
                 << ": the explicit scheme would be unstable. Use a time step <= "
                 << maximum_cfl * critical_step << " s or 0 (automatic).";
-              fail(m.str(), t);
+              throw Run::StepFailure(m.str());
             }
         }
-      else if (nominal == 0)
-        nominal = time.end_time / n_increments;
-      IncrementControl increments(nominal, newton.max_cuts);
+      return increments.step(t, this->get_scene().time_control().end_time);
+    }
 
-      while (t < time.end_time - eps)
+
+
+    template <int dim>
+    bool
+    Solver<dim>::advance(double &t, const double dt)
+    {
+      if (analysis == Analysis::explicit_dynamics)
+        explicit_step(t, dt);
+      else
         {
-          const double dt = increments.step(t, time.end_time);
-          if (analysis == Analysis::explicit_dynamics)
+          if (!implicit_step(t, dt))
             {
-              dealii::TimerOutput::Scope timing(scene.timer(), "steps");
-              explicit_step(t, dt);
+              if (increments.cut())
+                return false;
+              n_cuts = increments.cuts();
+              std::ostringstream m;
+              m << "fem: Newton did not converge in the increment from t = " << t << " s to "
+                << t + dt << " s after " << newton.max_cuts << " cuts (increment " << dt
+                << " s = " << increments.nominal() << " s / 2^" << newton.max_cuts << ")";
+              m << ": the structure may have reached its limit load (use displacement "
+                   "control), or the increments or the tangent are poor (newton.csv has "
+                   "the residuals)";
+              if (!material_failure.empty())
+                m << "; the last failure was in the material: " << material_failure;
+              else
+                m << "; the last residual was " << system_rhs.l2_norm() / force_level()
+                  << " of the force level (tolerance "
+                  << std::max(newton.tolerance, residual_floor()) << ")";
+              m << ".";
+              throw Run::StepFailure(m.str());
             }
-          else
-            {
-              bool converged = false;
-              {
-                dealii::TimerOutput::Scope timing(scene.timer(), "steps");
-                converged = implicit_step(t, dt);
-              }
-              if (!converged)
-                {
-                  if (!increments.cut())
-                    {
-                      std::ostringstream m;
-                      m << "fem: Newton did not converge in the increment from t = " << t
-                        << " s to " << t + dt << " s after " << newton.max_cuts
-                        << " cuts (increment " << dt << " s = " << nominal << " s / 2^"
-                        << newton.max_cuts << ")";
-                      m << ": the structure may have reached its limit load (use displacement "
-                           "control), or the increments or the tangent are poor (newton.csv has "
-                           "the residuals)";
-                      if (!material_failure.empty())
-                        m << "; the last failure was in the material: " << material_failure;
-                      else
-                        m << "; the last residual was " << system_rhs.l2_norm() / force_level()
-                          << " of the force level (tolerance "
-                          << std::max(newton.tolerance, residual_floor()) << ")";
-                      m << ".";
-                      fail(m.str(), t);
-                    }
-                  continue;
-                }
-              commit(t + dt, dt);
-            }
-          increments.accept(t, dt);
-          n_cuts = increments.cuts();
-          ++n_steps;
-          const bool last = !(t < time.end_time - eps);
-          if (rows.due(t, last))
-            write_table_rows(t);
-          if (fields.due(t, last))
-            write_fields(t);
-          progress.update(n_steps, t);
+          commit(t + dt, dt);
         }
-      progress.finish(n_steps, t);
-      commit_tables();
-      if (quadrature_table)
-        write_quadrature_table();
+      increments.accept(t, dt);
+      n_cuts = increments.cuts();
+      return true;
     }
 
 
 
     template <int dim>
     void
-    Solver<dim>::fail(const std::string &what, const double t)
+    Solver<dim>::finish(const double)
     {
-      // The converged state of t is the last good one: write it, then stop.
-      write_fields(t);
-      write_table_rows(t);
-      commit_tables();
-      throw RuntimeError(what + " The last good state (t = " + seconds(t) + " s) was written.");
+      if (quadrature_table)
+        write_quadrature_table();
     }
 
 
@@ -1042,10 +1019,10 @@ namespace hysteron
     Solver<dim>::summary() const
     {
       std::ostringstream s;
-      s << n_steps << " steps";
+      s << this->n_steps() << " steps";
       if (analysis != Analysis::explicit_dynamics)
         s << ", " << n_newton << " Newton iterations, " << n_cuts << " increment cuts";
-      s << ", " << dof_handler.n_dofs() << " DoFs, " << n_outputs << " outputs";
+      s << ", " << dof_handler.n_dofs() << " DoFs, " << this->n_outputs() << " outputs";
       return s.str();
     }
 

@@ -85,7 +85,7 @@ namespace hysteron
       const Scene<dim> &scene = this->get_scene();
       tables.open(scene, this->output_directory(), PointData::columns<dim>(state_names));
       if (scene.is_root() && analysis != Analysis::explicit_dynamics)
-        newton_table = std::make_unique<Output::CsvWriter>(
+        newton_table = std::make_unique<Output::TimeTable>(
           this->output_file("newton.csv"),
           std::vector<std::string>{"time", "step", "iteration", "residual", "force_level",
                                    "relative_residual", "line_search"});
@@ -228,12 +228,9 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::write_fields(const double t)
+    Solver<dim>::write_fields(const double t, Output::FieldWriter &writer)
     {
       using namespace dealii;
-      const Scene<dim> &scene = this->get_scene();
-      if (!scene.output_control().write_vtu)
-        return;
       // Cell averages of the quadrature-point values.
       const unsigned int n_cells = triangulation.n_active_cells();
       const unsigned int n_sym   = SymmetricTensor<2, dim>::n_independent_components;
@@ -291,8 +288,7 @@ namespace hysteron
       data_out.add_data_vector(body, "body", DataOut<dim>::type_cell_data);
       data_out.add_data_vector(subdomain, "subdomain", DataOut<dim>::type_cell_data);
       data_out.build_patches(mapping, degree);
-      field_writer->write(data_out, t);
-      ++n_outputs;
+      writer.write(data_out, t);
     }
 
 
@@ -349,15 +345,6 @@ namespace hysteron
     }
 
 
-
-    template <int dim>
-    void
-    Solver<dim>::commit_tables()
-    {
-      tables.commit();
-      if (newton_table)
-        newton_table->commit();
-    }
 
     template class Solver<2>;
     template class Solver<3>;

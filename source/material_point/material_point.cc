@@ -204,9 +204,9 @@ namespace hysteron
       material->initialize_state(dealii::make_array_view(state));
       Tensor2 strain, stress, previous_increment;
 
-      std::unique_ptr<Output::CsvWriter> csv;
+      std::unique_ptr<Output::TimeTable> csv;
       if (scene.is_root())
-        csv = std::make_unique<Output::CsvWriter>(scene.output_file("history.csv"), column_names());
+        csv = std::make_unique<Output::TimeTable>(scene.output_file("history.csv"), column_names());
 
       // One CSV row: all six components, the out-of-plane ones from the model in 2D.
       const auto write_row = [&](const double t) {
@@ -333,7 +333,7 @@ namespace hysteron
       // Timer sections synchronise the ranks: every rank enters them.
       dealii::TimerOutput::Scope output_timing(scene.timer(), "output");
       if (csv)
-        csv->commit();
+        csv->flush();
     }
 
     template <int dim>

@@ -106,9 +106,9 @@ namespace hysteron
       const Scene<dim> &scene = this->get_scene();
       using State             = Material::BoucWenUniaxial;
 
-      std::unique_ptr<Output::CsvWriter> csv;
+      std::unique_ptr<Output::TimeTable> csv;
       if (scene.is_root())
-        csv = std::make_unique<Output::CsvWriter>(scene.output_file("history.csv"), column_names());
+        csv = std::make_unique<Output::TimeTable>(scene.output_file("history.csv"), column_names());
 
       double state[State::max_n_state_variables];
       law.initialize_state(state);
@@ -171,7 +171,7 @@ namespace hysteron
         // Timer sections are collective: every rank enters it.
         dealii::TimerOutput::Scope output_timing(scene.timer(), "output");
         if (csv)
-          csv->commit();
+          csv->flush();
       }
     }
 

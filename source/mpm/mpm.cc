@@ -5,7 +5,6 @@
 #include <hysteron/base/energy_check.h>
 #include <hysteron/base/exceptions.h>
 #include <hysteron/base/parameters.h>
-#include <hysteron/base/progress.h>
 #include <hysteron/mpm/mpm.h>
 
 #include <algorithm>
@@ -880,21 +879,8 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::commit_tables()
+    Solver<dim>::write_fields(const double t, Output::FieldWriter &writer)
     {
-      tables.commit();
-    }
-
-
-
-    template <int dim>
-    void
-    Solver<dim>::write_fields(const double t)
-    {
-      const Scene<dim> &scene = this->get_scene();
-      if (!scene.output_control().write_vtu)
-        return;
-      dealii::TimerOutput::Scope timing(scene.timer(), "output");
       to_handler();
       using PI = PropertiesIndex<dim>;
       std::vector<std::string> names = PI::names(state_names);
@@ -903,21 +889,7 @@ namespace hysteron
       interpretations.resize(n_properties, dealii::DataComponentInterpretation::component_is_scalar);
       dealii::Particles::DataOut<dim> out;
       out.build_patches(*handler, names, interpretations);
-      field_writer->write(out, t);
-      ++n_outputs;
-    }
-
-
-
-    template <int dim>
-    void
-    Solver<dim>::fail(const std::string &what, const double t)
-    {
-      // The last good state is `current`: write it, then report.
-      write_fields(t);
-      write_table_rows(t);
-      commit_tables();
-      throw RuntimeError(what);
+      writer.write(out, t);
     }
 
 
@@ -938,8 +910,8 @@ namespace hysteron
             }
           std::ostringstream m;
           m.precision(6);
-          m << "mpm: " << failure << " in the step from t = " << t << " s (step " << n_steps + 1
-            << "): material point " << particles.id[s] << " of body '"
+          m << "mpm: " << failure << " in the step from t = " << t << " s (step "
+            << this->n_steps() + 1 << "): material point " << particles.id[s] << " of body '"
             << this->get_scene().body_descriptions()[particles.body[s]].name << "' at "
             << format_point(x, dim);
           if (failure == "a material point left the grid")
@@ -952,7 +924,7 @@ namespace hysteron
               << " s = h / max_p(c_p + |v_p|) (MPM/Maximum CFL number = " << maximum_cfl
               << "): the explicit scheme is probably unstable, use Time/Time step <= " << step_critical
               << " s";
-          m << ". The last good state (t = " << t << " s) was written.";
+          m << ".";
           message = m.str();
         }
       if (!grid->is_parallel())
@@ -966,9 +938,8 @@ namespace hysteron
 
 
     template <int dim>
-    template <typename Fail>
-    void
-    Solver<dim>::check_energy(const double t, const double dt, const double critical, Fail &&fail_at_t)
+    std::string
+    Solver<dim>::check_energy(const double t, const double dt, const double critical) const
     {
       // Divergence (energy_diverged()) of the deformable points: an unstable step, too large
       // for the grid or with points in cells whose nodes carry little mass. One sum per
@@ -979,61 +950,70 @@ namespace hysteron
                                     grid->mpi_communicator(),
                                     dealii::ArrayView<double>(sums.data(), sums.size()));
       const double input = initial_kinetic_energy + sums[2] + std::abs(sums[3]);
-      if (energy_diverged(sums[0] + sums[1], input))
-        {
-          std::ostringstream m;
-          m << "mpm: the explicit scheme diverged in the step from t = " << t << " s (step "
-            << n_steps + 1 << ", time step " << dt << " s = " << dt / critical
-            << " times the critical step h / max_p(c_p + |v_p|) = " << critical
-            << " s): the kinetic energy plus the internal work " << sums[0] + sums[1]
-            << " J is more than twice the energy put in (" << input
-            << " J: initial kinetic energy, work of gravity, loads, boundaries and rigid bodies). "
-            << "Reduce Time/CFL factor or Time/Time step; with the linear basis, points crossing "
-            << "into cells whose nodes carry little mass also cause this (a finer point "
-            << "spacing or the cubic B-spline basis helps). The last good state (t = " << t
-            << " s) was written.";
-          fail_at_t(m.str());
-        }
+      if (!energy_diverged(sums[0] + sums[1], input))
+        return "";
+      std::ostringstream m;
+      m << "mpm: the explicit scheme diverged in the step from t = " << t << " s (step "
+        << this->n_steps() + 1 << ", time step " << dt << " s = " << dt / critical
+        << " times the critical step h / max_p(c_p + |v_p|) = " << critical
+        << " s): the kinetic energy plus the internal work " << sums[0] + sums[1]
+        << " J is more than twice the energy put in (" << input
+        << " J: initial kinetic energy, work of gravity, loads, boundaries and rigid bodies). "
+        << "Reduce Time/CFL factor or Time/Time step; with the linear basis, points crossing "
+        << "into cells whose nodes carry little mass also cause this (a finer point "
+        << "spacing or the cubic B-spline basis helps).";
+      return m.str();
     }
 
 
 
     template <int dim>
     void
-    Solver<dim>::run()
+    Solver<dim>::setup()
     {
       const Scene<dim> &scene = this->get_scene();
-      const auto       &time  = scene.time_control();
-      {
-        dealii::TimerOutput::Scope timing(scene.timer(), "set-up");
-        setup_grid();
-        probes.clear();
-        for (const auto &p : scene.output_control().probe_points)
-          {
-            Probe probe;
-            probe.point = p;
-            probes.push_back(probe);
-          }
-        generate_particles();
-        from_handler();
-        setup_boundaries();
-        field_writer = std::make_unique<Output::FieldWriter>(this->output_directory(),
-                                                             "particles",
-                                                             scene.mpi_communicator());
-        open_tables();
-        // The smallest mass a node may have and still get a velocity.
-        double m_min = std::numeric_limits<double>::max();
-        for (const double m : particles.mass)
-          m_min = std::min(m_min, m);
-        m_min      = dealii::Utilities::MPI::min(m_min, scene.mpi_communicator());
-        small_mass = 1e-12 * m_min;
-      }
+      setup_grid();
+      probes.clear();
+      for (const auto &p : scene.output_control().probe_points)
+        {
+          Probe probe;
+          probe.point = p;
+          probes.push_back(probe);
+        }
+      generate_particles();
+      from_handler();
+      setup_boundaries();
+      // The smallest mass a node may have and still get a velocity.
+      double m_min = std::numeric_limits<double>::max();
+      for (const double m : particles.mass)
+        m_min = std::min(m_min, m);
+      m_min      = dealii::Utilities::MPI::min(m_min, scene.mpi_communicator());
+      small_mass = 1e-12 * m_min;
+      // The basis is chosen once: the step kernel is a template of it.
+      step_kernel = basis_name == "linear" ? &Solver::template step<Linear1D> :
+                                             &Solver::template step<CubicBSpline1D>;
+
       scene.console() << "mpm: " << n_global_particles << " material points, grid of ";
       for (unsigned int d = 0; d < dim; ++d)
         scene.console() << (d ? " x " : "") << n_cells[d];
       scene.console() << " cells (h = " << cell_size << " m), " << basis_name << " basis" << std::endl;
+    }
 
-      double t = 0;
+
+
+    template <int dim>
+    void
+    Solver<dim>::open_outputs()
+    {
+      open_tables();
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::initialize()
+    {
       internal_work = external_work = boundary_work = 0;
       initial_kinetic_energy = 0;
       for (const auto &group : particles.groups)
@@ -1042,84 +1022,86 @@ namespace hysteron
             initial_kinetic_energy += 0.5 * particles.mass[p] * particles.current.v[p].norm_square();
       if (grid->is_parallel())
         initial_kinetic_energy = dealii::Utilities::MPI::sum(initial_kinetic_energy, grid->mpi_communicator());
-      write_fields(t);
-      write_table_rows(t);
-      PointData::Schedule rows(probe_interval, time.end_time), fields(scene.output_control().interval, time.end_time);
-      Progress     progress(scene.console(), "mpm", time.end_time, scene.output_control().progress_interval);
-      const double eps = 1e-12 * time.end_time;
-      while (t < time.end_time - eps)
+    }
+
+
+
+    template <int dim>
+    double
+    Solver<dim>::propose_step(const double t)
+    {
+      const auto  &time     = this->get_scene().time_control();
+      const double critical = critical_time_step();
+      double       dt       = time.cfl_factor * critical;
+      if (!time.automatic_time_step())
         {
-          const double critical = critical_time_step();
-          double       dt       = time.cfl_factor * critical;
-          if (!time.automatic_time_step())
+          dt = time.time_step;
+          if (dt > maximum_cfl * critical)
             {
-              dt = time.time_step;
-              if (dt > maximum_cfl * critical)
-                {
-                  std::ostringstream m;
-                  m << "mpm: the time step " << dt << " s is above the critical step " << critical
-                    << " s = h / max_p(c_p + |v_p|) (eq. 4.47) times MPM/Maximum CFL number = "
-                    << maximum_cfl << " at t = " << t << " s (step " << n_steps + 1
-                    << "): the explicit scheme would be unstable. Use Time/Time step <= "
-                    << maximum_cfl * critical << " or 0 (automatic). The last good state (t = " << t
-                    << " s) was written.";
-                  fail(m.str(), t);
-                }
+              std::ostringstream m;
+              m << "mpm: the time step " << dt << " s is above the critical step " << critical
+                << " s = h / max_p(c_p + |v_p|) (eq. 4.47) times MPM/Maximum CFL number = "
+                << maximum_cfl << " at t = " << t << " s (step " << this->n_steps() + 1
+                << "): the explicit scheme would be unstable. Use Time/Time step <= "
+                << maximum_cfl * critical << " or 0 (automatic).";
+              throw Run::StepFailure(m.str());
             }
-          dt            = std::min(dt, time.end_time - t);
-          step_critical = critical;
-          step_dt       = dt;
-          // The work sums and reactions of the state t: a failed step leaves them so.
-          const std::array<double, 3> work_at_t{{internal_work, external_work, boundary_work}};
-          reactions_at_t = reactions; // a member: no allocation per step
-          const auto fail_at_t = [&](const std::string &what) {
-            internal_work = work_at_t[0];
-            external_work = work_at_t[1];
-            boundary_work = work_at_t[2];
-            reactions     = reactions_at_t;
-            fail(what, t);
-          };
-          {
-            dealii::TimerOutput::Scope timing(scene.timer(), "steps");
-            if (basis_name == "linear")
-              advance<Linear1D>(t, dt);
-            else
-              advance<CubicBSpline1D>(t, dt);
-          }
-          bool failed = failed_point >= 0;
-          if (grid->is_parallel())
-            failed = dealii::Utilities::MPI::logical_or(failed, grid->mpi_communicator());
-          if (failed)
-            fail_at_t(describe_failure(t));
-          check_energy(t, dt, critical, fail_at_t);
-          particles.commit();
-          t += dt;
-          ++n_steps;
-
-          // Points that left this rank's cells go to their new owner; many cell
-          // changes restore the cell order of the arrays (locality).
-          // (sorting is collective: every rank decides the same)
-          bool rebuild = left_subdomain || n_changed_cells > particles.size() / 4 + 16;
-          if (grid->is_parallel())
-            rebuild = dealii::Utilities::MPI::logical_or(rebuild, grid->mpi_communicator());
-          if (rebuild)
-            {
-              dealii::TimerOutput::Scope timing(scene.timer(), "sort and migrate");
-              to_handler();
-              handler->sort_particles_into_subdomains_and_cells();
-              from_handler();
-              ++n_rebuilds;
-            }
-
-          const bool last = !(t < time.end_time - eps);
-          if (rows.due(t, last))
-            write_table_rows(t);
-          if (fields.due(t, last))
-            write_fields(t);
-          progress.update(n_steps, t);
         }
-      progress.finish(n_steps, t);
-      commit_tables();
+      step_critical = critical;
+      step_dt       = std::min(dt, time.end_time - t);
+      return step_dt;
+    }
+
+
+
+    template <int dim>
+    bool
+    Solver<dim>::advance(double &t, const double dt)
+    {
+      // The work sums and reactions of the state t: a failed step leaves them so.
+      const std::array<double, 3> work_at_t{{internal_work, external_work, boundary_work}};
+      reactions_at_t = reactions; // a member: no allocation per step
+      const auto fail_at_t = [&](const std::string &what) {
+        internal_work = work_at_t[0];
+        external_work = work_at_t[1];
+        boundary_work = work_at_t[2];
+        reactions     = reactions_at_t;
+        throw Run::StepFailure(what);
+      };
+      (this->*step_kernel)(t, dt);
+      bool failed = failed_point >= 0;
+      if (grid->is_parallel())
+        failed = dealii::Utilities::MPI::logical_or(failed, grid->mpi_communicator());
+      if (failed)
+        fail_at_t(describe_failure(t));
+      if (const std::string diverged = check_energy(t, dt, step_critical); !diverged.empty())
+        fail_at_t(diverged);
+      particles.commit();
+      t += dt;
+
+      // Points that left this rank's cells go to their new owner; many cell
+      // changes restore the cell order of the arrays (locality).
+      // (sorting is collective: every rank decides the same)
+      bool rebuild = left_subdomain || n_changed_cells > particles.size() / 4 + 16;
+      if (grid->is_parallel())
+        rebuild = dealii::Utilities::MPI::logical_or(rebuild, grid->mpi_communicator());
+      if (rebuild)
+        {
+          dealii::TimerOutput::Scope timing(this->get_scene().timer(), "sort and migrate");
+          to_handler();
+          handler->sort_particles_into_subdomains_and_cells();
+          from_handler();
+          ++n_rebuilds;
+        }
+      return true;
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::finish(const double)
+    {
       if (particle_table)
         write_particle_table();
     }
@@ -1130,8 +1112,8 @@ namespace hysteron
     std::string
     Solver<dim>::summary() const
     {
-      return std::to_string(n_steps) + " steps, " + std::to_string(n_global_particles) +
-             " material points, " + std::to_string(n_outputs) + " outputs";
+      return std::to_string(this->n_steps()) + " steps, " + std::to_string(n_global_particles) +
+             " material points, " + std::to_string(this->n_outputs()) + " outputs";
     }
 
 

@@ -2,7 +2,6 @@
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 
 #include <hysteron/base/parameters.h>
-#include <hysteron/base/progress.h>
 #include <hysteron/material/bouc_wen.h>
 #include <hysteron/rbsn/model.h>
 #include <hysteron/rbsn/rbsn.h>
@@ -315,7 +314,7 @@ namespace hysteron
                                                f.h_b / mb.elasticity().shear_modulus());
           sp.k[2]      = sp.k[0] * l * l / 12;
           sp.thickness = t;
-          // B (eq. 3.6, with the errata of DESIGN.md §3): the displacement of P as a
+          // B (eq. 3.6, with the corrections in doc/theory.md): the displacement of P as a
           // point of cell b minus as a point of cell a, in the facet's (n, t) axes,
           // u_P = u_i - (y_P - y_i) theta_i, v_P = v_i + (x_P - x_i) theta_i.
           const dealii::Tensor<1, 2> n = f.normal, tt({-n[1], n[0]});
@@ -639,31 +638,16 @@ namespace hysteron
 
 
 
-    void
-    Model::fail(const std::string &what, const double t)
-    {
-      write_fields(t);
-      write_table_rows(t);
-      tables.commit();
-      for (auto *table : {newton_table.get(), fracture_table.get()})
-        if (table)
-          table->commit();
-      std::ostringstream s;
-      s << std::setprecision(6) << t;
-      throw RuntimeError(what + " The last good state (t = " + s.str() + " s) was written.");
-    }
-
-
-
     std::string
-    Model::summary() const
+    Model::summary(const unsigned long steps, const unsigned int outputs) const
     {
       std::ostringstream s;
-      s << network.cells.size() << " cells, " << network.facets.size() << " facets, " << n_steps
-        << " steps, " << n_newton << " Newton iterations";
+      s << network.cells.size() << " cells, " << network.facets.size() << " facets, "
+        << (analysis == Analysis::variable_order ? n_steps : steps) << " steps, " << n_newton
+        << " Newton iterations";
       if (fracture.enabled)
         s << ", " << n_broken << " broken facets";
-      s << ", " << n_outputs << " outputs";
+      s << ", " << outputs << " outputs";
       return s.str();
     }
 
@@ -695,18 +679,90 @@ namespace hysteron
         }
     }
 
+    // The driver's hooks: the network is two-dimensional, so only Solver<2> has a
+    // model (a 3D scene is refused when the parameters are read).
     template <int dim>
     void
-    Solver<dim>::run()
+    Solver<dim>::setup()
     {
-      model->run();
+      model->setup();
+    }
+
+    template <int dim>
+    std::string
+    Solver<dim>::checkpoint_unsupported() const
+    {
+      return model ? model->checkpoint_unsupported() : std::string();
+    }
+
+    template <int dim>
+    void
+    Solver<dim>::open_outputs()
+    {
+      model->open_outputs();
+    }
+
+    template <int dim>
+    void
+    Solver<dim>::initialize()
+    {
+      model->initialize();
+    }
+
+    template <int dim>
+    double
+    Solver<dim>::propose_step(const double t)
+    {
+      return model->propose_step(t);
+    }
+
+    template <int dim>
+    bool
+    Solver<dim>::advance(double &t, const double dt)
+    {
+      return model->advance(t, dt, [this](const double time) { this->step_finished(time); });
+    }
+
+    template <int dim>
+    void
+    Solver<dim>::write_rows(const double t)
+    {
+      model->write_rows(t);
+    }
+
+    template <int dim>
+    void
+    Solver<dim>::write_fields(const double t, Output::FieldWriter &writer)
+    {
+      model->write_fields(t, writer);
+    }
+
+    template <int dim>
+    void
+    Solver<dim>::finish(const double)
+    {
+      model->finish();
+    }
+
+    template <int dim>
+    void
+    Solver<dim>::save(Run::CheckpointWriter &out) const
+    {
+      model->save(out);
+    }
+
+    template <int dim>
+    void
+    Solver<dim>::load(Run::CheckpointReader &in)
+    {
+      model->load(in);
     }
 
     template <int dim>
     std::string
     Solver<dim>::summary() const
     {
-      return model ? model->summary() : std::string();
+      return model ? model->summary(this->n_steps(), this->n_outputs()) : std::string();
     }
 
     template class Solver<2>;

@@ -47,9 +47,8 @@ namespace hysteron
 
 
     void
-    Model::open_tables()
+    Model::locate_probes()
     {
-      tables.open(scene, method.output_directory(), point_columns());
       // Each probe: the cell whose nucleus is nearest (the Voronoi cell holding the
       // point) and the facet whose midpoint is nearest.
       probe_cell.clear();
@@ -76,21 +75,29 @@ namespace hysteron
               facet = e;
           probe_facet.push_back(facet);
         }
+    }
+
+
+
+    void
+    Model::open_tables()
+    {
+      tables.open(scene, method.output_directory(), point_columns());
       if (!scene.is_root())
         return;
       if (analysis == Analysis::variable_order)
-        newton_table = std::make_unique<Output::CsvWriter>(
+        newton_table = std::make_unique<Output::TimeTable>(
           method.output_file("ida.csv"),
           std::vector<std::string>{"time", "steps", "order", "step", "residuals", "jacobians",
                                    "nonlinear_iterations", "error_test_failures",
                                    "convergence_failures"});
       else if (analysis != Analysis::linear_static)
-        newton_table = std::make_unique<Output::CsvWriter>(
+        newton_table = std::make_unique<Output::TimeTable>(
           method.output_file("newton.csv"),
           std::vector<std::string>{"time", "step", "iteration", "residual", "force_level",
                                    "relative_residual", "line_search"});
       if (fracture.enabled)
-        fracture_table = std::make_unique<Output::CsvWriter>(
+        fracture_table = std::make_unique<Output::TimeTable>(
           method.output_file("fracture.csv"),
           std::vector<std::string>{"time", "facet", "x", "y", "s_n", "s_t", "R"});
     }
@@ -293,23 +300,9 @@ namespace hysteron
 
 
     void
-    Model::write_fields(const double t)
+    Model::write_fields(const double t, Output::FieldWriter &writer)
     {
-      if (!scene.output_control().write_vtu)
-        return;
-      field_writer->write_serial([this](std::ostream &out) { write_vtu(out); }, t);
-      ++n_outputs;
-    }
-
-
-
-    void
-    Model::commit_tables()
-    {
-      tables.commit();
-      for (auto *table : {newton_table.get(), fracture_table.get()})
-        if (table)
-          table->commit();
+      writer.write_serial([this](std::ostream &out) { write_vtu(out); }, t);
     }
 
 

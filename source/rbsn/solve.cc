@@ -1,7 +1,7 @@
 #include <deal.II/lac/full_matrix.h>
 
-#include <hysteron/base/progress.h>
 #include <hysteron/rbsn/model.h>
+#include <hysteron/run/stepping_method.h>
 
 #include <cmath>
 #include <iomanip>
@@ -455,20 +455,13 @@ namespace hysteron
 
 
     void
-    Model::run()
+    Model::setup()
     {
-      const auto &time = scene.time_control();
-      {
-        dealii::TimerOutput::Scope timing(scene.timer(), "set-up");
-        build_network();
-        setup_springs();
-        setup_system();
-        setup_conditions();
-        // Every rank holds the whole network; write_serial() writes on rank 0.
-        field_writer = std::make_unique<Output::FieldWriter>(method.output_directory(), "rbsn",
-                                                             scene.mpi_communicator());
-        open_tables();
-      }
+      build_network();
+      setup_springs();
+      setup_system();
+      setup_conditions();
+      locate_probes();
       scene.console() << "rbsn: " << network.cells.size() << " cells, " << network.facets.size()
                       << " facets (d_m = " << d_m << " m), " << 3 * network.cells.size() << " DoFs"
                       << std::endl;
@@ -478,8 +471,26 @@ namespace hysteron
                      "(Bouc-Wen: Integrator = adaptive or forward euler), so Newton converges "
                      "linearly; Integrator = backward euler gives quadratic convergence"
                   << std::endl;
+      const auto &time    = scene.time_control();
+      double      nominal = time_step > 0 ? time_step : time.time_step;
+      if (nominal == 0)
+        nominal = time.end_time / n_increments;
+      increments = IncrementControl(nominal, newton.max_cuts);
+    }
 
-      double t = 0;
+
+
+    void
+    Model::open_outputs()
+    {
+      open_tables();
+    }
+
+
+
+    void
+    Model::initialize()
+    {
       // The initial state: forces at t = 0, and the initial acceleration in dynamics.
       make_constraints(0, 0, false);
       u_trial = u;
@@ -489,19 +500,42 @@ namespace hysteron
       reaction_old -= f_ext;
       if (dynamic())
         initial_state();
-      write_fields(t);
-      write_table_rows(t);
+    }
 
-      double nominal = time_step > 0 ? time_step : time.time_step;
-      if (nominal == 0)
-        nominal = time.end_time / n_increments;
-      IncrementControl    increments(nominal, newton.max_cuts);
-      PointData::Schedule rows(scene.output_control().probe_interval, time.end_time);
-      PointData::Schedule fields(scene.output_control().interval, time.end_time);
-      Progress progress(scene.console(), "rbsn", time.end_time, scene.output_control().progress_interval);
+
+
+    std::string
+    Model::checkpoint_unsupported() const
+    {
       if (analysis == Analysis::variable_order)
-        t = integrate_variable_order(nominal, rows, fields, progress);
-      const double eps = 1e-12 * time.end_time;
+        return "Analysis = variable order keeps SUNDIALS IDA's multistep history, which a "
+               "checkpoint cannot hold; Analysis = implicit dynamics (Newmark / HHT) can be "
+               "checkpointed";
+      return "";
+    }
+
+
+
+    double
+    Model::propose_step(const double t)
+    {
+      const double end_time = scene.time_control().end_time;
+      if (analysis == Analysis::variable_order)
+        return end_time - t;
+      return increments.step(t, end_time);
+    }
+
+
+
+    bool
+    Model::advance(double &t, const double dt, const std::function<void(double)> &step_finished)
+    {
+      if (analysis == Analysis::variable_order)
+        {
+          // IDA chooses its steps; the driver's work follows each output time.
+          t = integrate_variable_order(increments.nominal(), step_finished);
+          return false;
+        }
       // The facets broken since the converged state t in this attempt of the increment,
       // with their fracture.csv rows. They are intact again when the increment is cut (a
       // break decided at a load the shorter step does not reach) and in the last good
@@ -524,90 +558,83 @@ namespace hysteron
       const auto fail_at_t = [&](const std::string &what) {
         restore_t();
         write_breaks();
-        fail(what, t);
+        throw Run::StepFailure(what);
       };
-      while (t < time.end_time - eps)
+
+      bool converged = false;
+      try
         {
-          const double dt = increments.step(t, time.end_time);
-          bool         converged = false;
-          {
-            dealii::TimerOutput::Scope timing(scene.timer(), "steps");
-            try
-              {
-                converged = solve_step(t, dt);
-              }
-            catch (const RuntimeError &error)
-              {
-                fail_at_t(std::string(error.what()) + " (step to t = " + std::to_string(t + dt) + " s).");
-              }
-            // Fracture: break the facet with the largest R > 1, solve the step again.
-            for (unsigned int cycle = 0; converged && fracture.enabled; ++cycle)
-              {
-                const int e = facet_to_break();
-                if (e < 0)
-                  break;
-                if (cycle >= fracture.max_cycles)
-                  fail_at_t("rbsn: more than " + std::to_string(fracture.max_cycles) +
-                            " facets break in the step to t = " + std::to_string(t + dt) +
-                            " s: the network falls apart.");
-                break_rows.push_back(break_row(e, t + dt));
-                springs[e].broken = true;
-                ++n_broken;
-                broken_since_t.push_back(e);
-                try
-                  {
-                    converged = solve_step(t, dt);
-                  }
-                catch (const RuntimeError &error)
-                  {
-                    std::ostringstream where;
-                    where << network.facets[e].midpoint;
-                    fail_at_t(std::string(error.what()) + " after the facet at (" + where.str() +
-                              ") broke at t = " + std::to_string(t + dt) +
-                              " s: the structure has fallen apart.");
-                  }
-              }
-          }
-          if (!converged)
-            {
-              if (!increments.cut())
-                {
-                  std::ostringstream m;
-                  m << "rbsn: Newton did not converge in the increment from t = " << t << " s to "
-                    << t + dt << " s (increment " << dt << " s = " << nominal << " s / 2^"
-                    << newton.max_cuts << ") after " << newton.max_cuts
-                    << " cuts: the structure may have reached its limit load (use displacement "
-                    << "control)";
-                  if (!broken_since_t.empty())
-                    m << "; " << broken_since_t.size() << " facets broke in its last attempt, "
-                      << "the network may have fallen apart";
-                  if (!spring_failure.empty())
-                    m << "; the last failure was in a spring: " << spring_failure;
-                  else
-                    m << "; the last residual was " << rhs.l2_norm() / force_level()
-                      << " of the force level (tolerance " << newton.tolerance << ")";
-                  m << ".";
-                  fail_at_t(m.str());
-                }
-              restore_t();
-              break_rows.clear();
-              continue;
-            }
-          commit(t + dt, dt);
-          broken_since_t.clear();
-          write_breaks();
-          increments.accept(t, dt);
-          n_cuts = increments.cuts();
-          ++n_steps;
-          const bool last = !(t < time.end_time - eps);
-          if (rows.due(t, last))
-            write_table_rows(t);
-          if (fields.due(t, last))
-            write_fields(t);
-          progress.update(n_steps, t);
+          converged = solve_step(t, dt);
         }
-      progress.finish(n_steps, t);
-      commit_tables();
+      catch (const RuntimeError &error)
+        {
+          fail_at_t(std::string(error.what()) + " (step to t = " + std::to_string(t + dt) + " s).");
+        }
+      // Fracture: break the facet with the largest R > 1, solve the step again.
+      for (unsigned int cycle = 0; converged && fracture.enabled; ++cycle)
+        {
+          const int e = facet_to_break();
+          if (e < 0)
+            break;
+          if (cycle >= fracture.max_cycles)
+            fail_at_t("rbsn: more than " + std::to_string(fracture.max_cycles) +
+                      " facets break in the step to t = " + std::to_string(t + dt) +
+                      " s: the network falls apart.");
+          break_rows.push_back(break_row(e, t + dt));
+          springs[e].broken = true;
+          ++n_broken;
+          broken_since_t.push_back(e);
+          try
+            {
+              converged = solve_step(t, dt);
+            }
+          catch (const RuntimeError &error)
+            {
+              std::ostringstream where;
+              where << network.facets[e].midpoint;
+              fail_at_t(std::string(error.what()) + " after the facet at (" + where.str() +
+                        ") broke at t = " + std::to_string(t + dt) +
+                        " s: the structure has fallen apart.");
+            }
+        }
+      if (!converged)
+        {
+          if (!increments.cut())
+            {
+              n_cuts = increments.cuts();
+              std::ostringstream m;
+              m << "rbsn: Newton did not converge in the increment from t = " << t << " s to "
+                << t + dt << " s (increment " << dt << " s = " << increments.nominal()
+                << " s / 2^" << newton.max_cuts << ") after " << newton.max_cuts
+                << " cuts: the structure may have reached its limit load (use displacement "
+                << "control)";
+              if (!broken_since_t.empty())
+                m << "; " << broken_since_t.size() << " facets broke in its last attempt, "
+                  << "the network may have fallen apart";
+              if (!spring_failure.empty())
+                m << "; the last failure was in a spring: " << spring_failure;
+              else
+                m << "; the last residual was " << rhs.l2_norm() / force_level()
+                  << " of the force level (tolerance " << newton.tolerance << ")";
+              m << ".";
+              fail_at_t(m.str());
+            }
+          restore_t();
+          break_rows.clear();
+          return false;
+        }
+      commit(t + dt, dt);
+      write_breaks();
+      increments.accept(t, dt);
+      n_cuts = increments.cuts();
+      return true;
+    }
+
+
+
+    void
+    Model::finish()
+    {
       if (spring_table)
         write_spring_table();
     }

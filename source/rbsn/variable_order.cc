@@ -4,6 +4,7 @@
 
 #include <hysteron/base/parameters.h>
 #include <hysteron/rbsn/model.h>
+#include <hysteron/run/stepping_method.h>
 
 #include <algorithm>
 #include <cmath>
@@ -555,10 +556,8 @@ namespace hysteron
 
 
     double
-    Model::integrate_variable_order(const double         output_interval,
-                                    PointData::Schedule &rows,
-                                    PointData::Schedule &fields,
-                                    Progress            &progress)
+    Model::integrate_variable_order(const double                       output_interval,
+                                    const std::function<void(double)> &step_finished)
     {
       const auto  &p        = variable_order;
       const double end_time = scene.time_control().end_time;
@@ -639,7 +638,7 @@ namespace hysteron
               << "steps (1e6 per output interval).";
             if (!ida_error.empty())
               s << " IDA: " << ida_error;
-            fail(s.str(), last_good);
+            throw Run::StepFailure(s.str());
           }
         // The wrapper's output times accumulate round-off (t is k output_interval within
         // eps): the tables get the nominal time, and a last interval of round-off length
@@ -651,20 +650,12 @@ namespace hysteron
         if (newton_table)
           newton_table->add_row({expected, double(steps), double(order), h, double(residuals), double(setups),
                                  double(iterations), double(error_fails), double(convergence_fails)});
-        const bool last = !(expected < end_time - eps);
-        if (rows.due(expected, last))
-          write_table_rows(expected);
-        if (fields.due(expected, last))
-          write_fields(expected);
-        progress.update(n_steps, expected);
+        step_finished(expected);
       };
 
       Vector y, yp;
       dae.initial_values(y, yp);
-      {
-        dealii::TimerOutput::Scope timing(scene.timer(), "steps");
-        ida.solve_dae(y, yp);
-      }
+      ida.solve_dae(y, yp);
       return end_time;
     }
   } // namespace RBSN

@@ -22,7 +22,7 @@ namespace hysteron
   namespace
   {
     const char *usage_text =
-      "Usage: hysteron [--quiet] [--compare] SCENE.prm\n"
+      "Usage: hysteron [--quiet] [--compare] [--resume] SCENE.prm\n"
       "       hysteron --print-parameters [prm|json|markdown] [SCENE.prm]\n"
       "       hysteron --help | --version\n"
       "\n"
@@ -33,13 +33,18 @@ namespace hysteron
       "  --quiet              no progress, summary or timer table on stdout\n"
       "  --compare            run the scene with two methods (Compare/Methods, default mpm\n"
       "                       and fem) and compare their tables (= set Method = compare)\n"
+      "  --resume             continue the run of SCENE.prm from the newest checkpoint in\n"
+      "                       its output directory (subsection Checkpoint; a run stopped by\n"
+      "                       SIGINT or SIGTERM writes one), with as many MPI ranks as before\n"
       "  --print-parameters   write every parameter with its default, allowed values and\n"
       "                       documentation (PRM, JSON or Markdown) and exit; with SCENE.prm,\n"
       "                       the values of that file and its named materials\n"
       "  --help               this text\n"
       "  --version            the version\n"
       "\n"
-      "Exit status: 0 success, 1 bad input, 2 run-time failure, 3 internal error.\n"
+      "Exit status: 0 success, 1 bad input (nothing written), 2 run-time failure (the last\n"
+      "good state written), 3 internal error, 4 stopped by SIGINT or SIGTERM (state and a\n"
+      "checkpoint written; continue with --resume).\n"
       "Documentation: README.md, doc/parameters.md, doc/architecture.md.\n";
 
     /// A deal.II exception's own message, on one line, without the source location banner.
@@ -128,6 +133,8 @@ namespace hysteron
     run(int argc, char **argv)
     {
       RunOptions  options;
+      for (int i = 0; i < argc; ++i)
+        options.command_line += (i ? " " : "") + std::string(argv[i]);
       bool        print_parameters = false;
       bool        compare          = false;
       std::string format           = "prm";
@@ -151,6 +158,8 @@ namespace hysteron
             options.quiet = true;
           else if (arg == "--compare")
             compare = true;
+          else if (arg == "--resume")
+            options.resume = true;
           else if (arg == "--print-parameters")
             {
               print_parameters = true;
@@ -257,6 +266,11 @@ namespace hysteron
       {
         report("run-time error", e.what());
         return 2;
+      }
+    catch (const Interrupted &e)
+      {
+        report("interrupted", e.what());
+        return 4;
       }
     catch (const dealii::ExceptionBase &e)
       {

@@ -48,6 +48,13 @@ namespace hysteron
       }
 
       void
+      setup() override
+      {
+        for (auto &method : methods)
+          method->setup();
+      }
+
+      void
       run() override
       {
         const Scene<dim> &scene = this->get_scene();

@@ -5,6 +5,9 @@
 #include <hysteron/base/parameters.h>
 #include <hysteron/scene/scene.h>
 
+#include "run/checkpoint_files.h"
+#include "run/output_directory.h"
+
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -110,7 +113,8 @@ namespace hysteron
       prm.declare_entry("Probe points",
                         "",
                         Patterns::Anything(),
-                        "Points whose history is written to probes.csv, as 'x,y; x,y' in 2D or "
+                        "Points whose history is written to probe_<i>.csv (i = 0, 1, ... in the "
+                        "order given), as 'x,y; x,y' in 2D or "
                         "'x,y,z; ...' in 3D [m] (field methods only).");
       prm.declare_entry("Probe interval",
                         "0",
@@ -129,6 +133,27 @@ namespace hysteron
                         "2",
                         Patterns::Double(),
                         "Wall-clock seconds between progress lines, > 0 (silenced by --quiet).");
+    }
+    prm.leave_subsection();
+
+    prm.enter_subsection("Checkpoint");
+    {
+      prm.declare_entry("Interval",
+                        "0",
+                        Patterns::Integer(0),
+                        "Steps (or load increments) between checkpoints of a time-stepping "
+                        "method (mpm, fem, rbsn), >= 0; 0: none. `hysteron --resume scene.prm` "
+                        "continues a run from the newest checkpoint in its output directory.");
+      prm.declare_entry("Wall-clock interval",
+                        "0",
+                        Patterns::Double(0),
+                        "Wall-clock minutes between checkpoints, >= 0; 0: none. Both intervals may "
+                        "be set. A run stopped by SIGINT or SIGTERM always writes one.");
+      prm.declare_entry("Number kept",
+                        "2",
+                        Patterns::Integer(1),
+                        "How many checkpoints (the newest) stay in the output directory, >= 1; "
+                        "each is written completely before the oldest is removed.");
     }
     prm.leave_subsection();
 
@@ -203,7 +228,7 @@ namespace hysteron
   void
   Scene<dim>::parse(dealii::ParameterHandler &prm)
   {
-    method_name = prm.get("Method");
+    method_name_ = prm.get("Method");
     seed        = prm.get_integer("Random seed");
 
     {
@@ -231,6 +256,13 @@ namespace hysteron
             Geometry::Region<dim>::parse(expression, s.where("Average regions")));
     }
 
+    {
+      Section s(prm, {"Checkpoint"});
+      checkpoint.interval     = s.get_integer("Interval");
+      checkpoint.wall_minutes = s.get_non_negative("Wall-clock interval");
+      checkpoint.keep         = s.get_integer("Number kept");
+    }
+
     const SceneNames scene_names = SceneNames::read(prm);
     std::vector<std::string> names{""};
     names.insert(names.end(), scene_names.materials.begin(), scene_names.materials.end());
@@ -252,10 +284,10 @@ namespace hysteron
 
     std::ostringstream text;
     prm.print_parameters(text, dealii::ParameterHandler::ShortPRM);
-    effective_parameters = "# Parameters of this hysteron " HYSTERON_VERSION " run (" +
+    effective_parameters_ = "# Parameters of this hysteron " HYSTERON_VERSION " run (" +
                            options.parameter_file + "), defaults included.\n" + text.str();
 
-    method = Methods::Registry<dim>::create(method_name, "Method");
+    method = Methods::Registry<dim>::create(method_name_, "Method");
     method->initialize(*this, prm);
   }
 
@@ -302,31 +334,61 @@ namespace hysteron
   void
   Scene<dim>::run()
   {
-    // Directory problems are input errors; rank 0 decides, every rank reports.
-    std::string problem;
-    if (is_root())
-      try
-        {
-          Output::prepare_directory(output.directory, "Output/Directory");
-          Output::write_file(output_file("parameters.prm"), effective_parameters);
-        }
-      catch (const InputError &e)
-        {
-          problem = e.problem();
-        }
-    problem = dealii::Utilities::MPI::broadcast(options.comm, problem, 0);
-    if (!problem.empty())
-      throw InputError("Output/Directory", problem);
+    const MPI_Comm comm = options.comm;
+    // A directory that another run is writing is refused before any work.
+    Run::OutputDirectory::check_not_in_use(output.directory, comm);
+    if (checkpoint.enabled() || options.resume)
+      {
+        const std::string why = method->checkpoint_unsupported();
+        require(why.empty(),
+                options.resume ? "--resume" : "Checkpoint",
+                "method '" + method_name_ + "': " + why);
+      }
+    if (options.resume)
+      {
+        // Refuse a missing or foreign checkpoint before the set-up.
+        Run::open_resume(method->output_directory(), method_name_, effective_parameters_, comm);
+      }
 
     dealii::Timer wall;
     wall.start();
     pcout << "hysteron " HYSTERON_VERSION ": " << dim << "D scene '" << options.parameter_file
-          << "', method '" << method_name << "'" << std::endl;
-    method->run();
+          << "', method '" << method_name_ << "'" << std::endl;
+    {
+      dealii::TimerOutput::Scope timing(*computing_timer, "set-up");
+      method->setup();
+    }
+
+    // Only a scene that set up without a problem writes files.
+    Run::RunDescription description;
+    description.command        = options.command_line;
+    description.parameter_file = options.parameter_file;
+    description.method         = method_name_;
+    description.n_ranks        = dealii::Utilities::MPI::n_mpi_processes(comm);
+    Run::OutputDirectory directory;
+    directory.open(output.directory, description, options.resume, comm);
+    if (is_root())
+      Output::write_file(output_file("parameters.prm"), effective_parameters_);
+
+    try
+      {
+        method->run();
+      }
+    catch (const Interrupted &e)
+      {
+        directory.close("interrupted", e.what());
+        throw;
+      }
+    catch (const std::exception &e)
+      {
+        directory.close("failed", e.what());
+        throw;
+      }
     wall.stop();
 
-    pcout << "hysteron: '" << method_name << "' finished in " << wall.wall_time() << " s";
     const std::string s = method->summary();
+    directory.close("finished", s);
+    pcout << "hysteron: '" << method_name_ << "' finished in " << wall.wall_time() << " s";
     if (!s.empty())
       pcout << " (" << s << ")";
     pcout << ".\nResults are in " << output.directory << "/" << std::endl;

@@ -22,17 +22,17 @@ namespace hysteron
           std::vector<std::string> c{"time"};
           c.insert(c.end(), point.begin(), point.end());
           probe_tables.push_back(
-            std::make_unique<Output::CsvWriter>(file("probe_" + std::to_string(i) + ".csv"), c));
+            std::make_unique<Output::TimeTable>(file("probe_" + std::to_string(i) + ".csv"), c));
         }
       for (unsigned int i = 0; i < scene.output_control().average_regions.size(); ++i)
         {
           std::vector<std::string> c{"time", "mass"};
           c.insert(c.end(), point.begin(), point.end());
           average_tables.push_back(
-            std::make_unique<Output::CsvWriter>(file("average_" + std::to_string(i) + ".csv"), c));
+            std::make_unique<Output::TimeTable>(file("average_" + std::to_string(i) + ".csv"), c));
         }
-      energy_table   = std::make_unique<Output::CsvWriter>(file("energy.csv"), energy_columns());
-      reaction_table = std::make_unique<Output::CsvWriter>(file("reactions.csv"), reaction_columns(scene));
+      energy_table   = std::make_unique<Output::TimeTable>(file("energy.csv"), energy_columns());
+      reaction_table = std::make_unique<Output::TimeTable>(file("reactions.csv"), reaction_columns(scene));
     }
 
 
@@ -102,16 +102,42 @@ namespace hysteron
 
     template <int dim>
     void
-    Tables<dim>::commit()
+    Tables<dim>::flush()
     {
       for (auto &table : probe_tables)
-        table->commit();
+        table->flush();
       for (auto &table : average_tables)
-        table->commit();
+        table->flush();
       for (auto *table : {energy_table.get(), reaction_table.get()})
         if (table)
-          table->commit();
+          table->flush();
     }
+
+
+
+    template <int dim>
+    void
+    Tables<dim>::save(Run::CheckpointWriter &out) const
+    {
+      out.section("tables");
+      out.put(has_written);
+      out.put(last_time);
+      out.put(energy_log.state());
+    }
+
+
+
+    template <int dim>
+    void
+    Tables<dim>::load(Run::CheckpointReader &in)
+    {
+      in.section("tables");
+      in.get(has_written);
+      in.get(last_time);
+      energy_log.restore(in.get<std::array<double, 3>>());
+    }
+
+
 
     template class Tables<2>;
     template class Tables<3>;

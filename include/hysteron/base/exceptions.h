@@ -45,6 +45,17 @@ namespace hysteron
     explicit RuntimeError(const std::string &message);
   };
 
+  /**
+   * The run was stopped by SIGINT or SIGTERM after it wrote its state (tables,
+   * a VTU, a checkpoint); the executable prints the message and exits with
+   * status 4. `hysteron --resume` continues it.
+   */
+  class Interrupted : public std::runtime_error
+  {
+  public:
+    using std::runtime_error::runtime_error;
+  };
+
   /// Throw InputError(where, problem) unless @p condition holds.
   inline void
   require(const bool condition, const std::string &where, const std::string &problem)

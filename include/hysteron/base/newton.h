@@ -6,6 +6,7 @@
 #include <hysteron/base/parameters.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace hysteron
@@ -136,6 +137,22 @@ namespace hysteron
     cuts() const
     {
       return n_cuts;
+    }
+
+    /// The state between increments (nominal step, level, successes, cuts), for a checkpoint.
+    std::array<double, 4>
+    state() const
+    {
+      return {{nominal_step, double(level), double(successes), double(n_cuts)}};
+    }
+
+    void
+    restore(const std::array<double, 4> &s)
+    {
+      nominal_step = s[0];
+      level        = static_cast<unsigned int>(s[1]);
+      successes    = static_cast<unsigned int>(s[2]);
+      n_cuts       = static_cast<unsigned int>(s[3]);
     }
 
   private:

@@ -4,6 +4,7 @@
 #include <deal.II/base/data_out_base.h>
 #include <deal.II/base/mpi.h>
 
+#include <cstdint>
 #include <fstream>
 #include <functional>
 #include <string>
@@ -65,8 +66,9 @@ namespace hysteron
     write_file(const std::string &filename, const std::string &content);
 
     /**
-     * A CSV table with a header line. Rows are written with 15 significant
-     * digits. The table is an AtomicFile: it appears under its name on commit().
+     * A CSV table written whole at the end of a run (particles.csv, springs.csv):
+     * a header line, rows with 15 significant digits; an AtomicFile, so it
+     * appears under its name on commit() and never half-written.
      */
     class CsvWriter
     {
@@ -94,6 +96,67 @@ namespace hysteron
       AtomicFile               file;
     };
 
+    /// One CSV row as text (15 significant digits, -0 printed as 0), with its newline.
+    std::string
+    format_row(const std::vector<double> &values);
+
+    /**
+     * A time table (probes, energies, reactions, Newton log, history): written
+     * under its final name as the rows are produced, so that a run killed at any
+     * moment (SIGKILL, a crash, a power cut) leaves a readable table of complete
+     * rows. Rows are buffered and appended with one write() of whole lines at most
+     * every half second of wall time (or 64 KiB), at flush(), at a checkpoint and
+     * at the end of the run; the file never ends inside a row.
+     *
+     * Every open time table is known to the RunRecord: a checkpoint records the
+     * length of each, and a resumed run (hysteron --resume) cuts each table back
+     * to that length and appends, so that its tables equal an uninterrupted run's.
+     */
+    class TimeTable
+    {
+    public:
+      TimeTable(const std::string &filename, const std::vector<std::string> &columns);
+      ~TimeTable();
+
+      TimeTable(const TimeTable &) = delete;
+      TimeTable &
+      operator=(const TimeTable &) = delete;
+
+      std::size_t
+      n_columns() const
+      {
+        return n_columns_;
+      }
+
+      /// Append one row; its length must equal the number of columns.
+      void
+      add_row(const std::vector<double> &values);
+
+      /// Write the buffered rows. Throws RuntimeError on an I/O error.
+      void
+      flush();
+
+      /// The length of the file once flushed [bytes].
+      std::uint64_t
+      size() const
+      {
+        return written + buffer.size();
+      }
+
+      const std::string &
+      filename() const
+      {
+        return name;
+      }
+
+    private:
+      std::string   name;
+      std::size_t   n_columns_ = 0;
+      int           fd         = -1;
+      std::string   buffer;
+      std::uint64_t written    = 0;
+      double        last_flush = 0;
+    };
     /**
      * Field output for ParaView: every call to write() produces
      * "<base>-<step>.vtu" (on one rank) or "<base>-<step>.<rank>.vtu" plus a
@@ -124,6 +187,14 @@ namespace hysteron
       records() const
       {
         return times_and_names;
+      }
+
+      /// Resume: continue the series after these records (of a checkpoint).
+      void
+      restore(const std::vector<std::pair<double, std::string>> &records)
+      {
+        times_and_names = records;
+        counter         = records.size();
       }
 
     private:

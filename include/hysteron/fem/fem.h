@@ -17,6 +17,7 @@
 #include <hysteron/geometry/region.h>
 #include <hysteron/scene/method.h>
 #include <hysteron/scene/point_data.h>
+#include <hysteron/run/stepping_method.h>
 #include <hysteron/scene/tables.h>
 #include <hysteron/scene/scene.h>
 
@@ -80,7 +81,7 @@ namespace hysteron
 
     /// See the namespace documentation.
     template <int dim>
-    class Solver : public Methods::Interface<dim>
+    class Solver : public Run::SteppingMethod<dim>
     {
     public:
       Solver();
@@ -90,14 +91,51 @@ namespace hysteron
       declare_parameters(dealii::ParameterHandler &prm);
 
       void
-      run() override;
+      setup() override;
 
       std::string
       summary() const override;
 
+      std::string
+      checkpoint_unsupported() const override
+      {
+        return "";
+      }
+
     protected:
       void
       parse_parameters(dealii::ParameterHandler &prm) override;
+
+      // The driver's hooks (Run::SteppingMethod): the loop is the driver's.
+      std::string
+      label() const override
+      {
+        return "fem";
+      }
+      std::string
+      field_name() const override
+      {
+        return "fem";
+      }
+      void
+      open_outputs() override;
+      double
+      propose_step(double t) override;
+      bool
+      advance(double &t, double dt) override;
+      void
+      write_rows(double t) override
+      {
+        write_table_rows(t);
+      }
+      void
+      write_fields(double t, Output::FieldWriter &writer) override;
+      void
+      finish(double t) override;
+      void
+      save(Run::CheckpointWriter &out) const override;
+      void
+      load(Run::CheckpointReader &in) override;
 
     private:
       using Vector = dealii::TrilinosWrappers::MPI::Vector;
@@ -289,13 +327,7 @@ namespace hysteron
       void
       write_table_rows(const double t);
       void
-      write_fields(const double t);
-      void
       write_quadrature_table() const;
-      void
-      commit_tables();
-      [[noreturn]] void
-      fail(const std::string &what, const double t);
 
       /// The reaction (force of the constraint on the body) of every Dirichlet set: this rank's part.
       std::vector<dealii::Tensor<1, dim>>
@@ -362,13 +394,15 @@ namespace hysteron
       // Diagnostics and bookkeeping.
       std::string                                      material_failure;
       std::vector<Probe>                               probes;
-      std::unique_ptr<Output::FieldWriter>             field_writer;
       PointData::Tables<dim>                           tables;
-      std::unique_ptr<Output::CsvWriter>               newton_table;
+      std::unique_ptr<Output::TimeTable>               newton_table;
       /// Work of this rank's cells and DoFs since t = 0 (summed when a row is written).
       double internal_work = 0, external_work = 0, boundary_work = 0;
-      unsigned long n_steps = 0, n_newton = 0, n_cuts = 0, n_linear = 0;
-      unsigned int  n_outputs = 0;
+      unsigned long n_newton = 0, n_cuts = 0, n_linear = 0;
+      /// The load increments (their cuts and recovery); the nominal step is set at set-up.
+      IncrementControl increments{1.0, 0};
+      /// The nominal step was checked against the critical step of explicit dynamics.
+      bool          step_checked = false;
       double        critical_step = 0;
       /// Explicit dynamics: the kinetic energy at t = 0 (whole mesh; < 0 before the
       /// first step), for the divergence check of explicit_step().

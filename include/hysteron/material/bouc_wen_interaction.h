@@ -39,19 +39,19 @@ namespace hysteron
      *   H1 = Phi^n,   H2 = beta + gamma sgn(g^T E delta').
      *
      * <h3>Two corrections of eq. 3.40</h3>
-     * - The seed prints H1 = |Phi + 1|^n. With Phi normalised to 1 at yield (eq. 3.41)
+     * - The dissertation prints H1 = |Phi + 1|^n. With Phi normalised to 1 at yield (eq. 3.41)
      *   this is >= 1 already at F^h = 0 (the springs would flow from the start); the
      *   smooth Heaviside function of eq. 2.33 is the n-th power of the criterion
      *   normalised to 1 at yield, so H1 = Phi^n (|Phi + 1|^n would be right for a
      *   yield function written Phi - 1, i.e. if "Phi" in eq. 3.40 stood for Phi - 1).
-     * - The seed's sign argument is F^h . delta'. We use g^T E delta', the rate of Phi
+     * - The dissertation's sign argument is F^h . delta'. We use g^T E delta', the rate of Phi
      *   of an elastic trial (the argument n : D : eps' of the triaxial law, eq. 2.33).
      *   Both agree when one component is loaded alone, but F^h . delta' weights the
      *   components differently from Phi: where F^h . delta' < 0 < g^T E delta' the
      *   "unloading" switch (H2 = 0 for beta = gamma) would let Phi grow past 1 without
      *   flow, and where g^T E delta' < 0 < F^h . delta' the flow would be
      *   negative (lambda' < 0, negative dissipation).
-     * As everywhere in hysteron gamma multiplies the sign (DESIGN.md §3; eq. 3.36 and
+     * As everywhere in hysteron gamma multiplies the sign (doc/theory.md; eq. 3.36 and
      * 3.40 print beta and gamma swapped).
      *
      * <h3>Derivation (in w)</h3>
@@ -116,7 +116,7 @@ namespace hysteron
      * intrinsic time xi' = |delta_p'| and its energy scale F_y z_y belong to one spring;
      * for the coupled facet the plastic deformation (delta_n, delta_t in m, phi in rad)
      * has no unique norm and the three springs no common energy scale, so eta and nu_s
-     * would be a new model, not the seed's.
+     * would be a new model, not the dissertation's.
      *
      * <h3>State</h3>
      * The three hysteretic deformations z = (z_n, z_t, z_phi) (the units of delta),

@@ -22,7 +22,7 @@ namespace hysteron
 
     /**
      * Parameters of the smooth Bouc-Wen law, shared by the uniaxial law
-     * (springs, 1D) and the triaxial von Mises law. Convention (DESIGN.md §3):
+     * (springs, 1D) and the triaxial von Mises law. Convention (doc/theory.md):
      *   z' = eps' / eta [1 - nu_s |z/z_y|^n (beta + gamma sgn(z eps'))],
      * gamma multiplies the sign term; admissible: -beta <= gamma <= beta, beta + gamma > 0
      * (beta + gamma = 1 for z_y to be the saturation value).

@@ -29,7 +29,7 @@ namespace hysteron
      *   sigma = a k eps + (1 - a) k z,
      *   z'    = eps' / eta [1 - nu_s |z/z_y|^n (beta + gamma sgn(z eps'))],
      *
-     * (eq. 2.3, 2.5, 2.37; gamma multiplies the sign term, DESIGN.md §3; eq. 3.36
+     * (eq. 2.3, 2.5, 2.37; gamma multiplies the sign term, doc/theory.md; eq. 3.36
      * prints beta and gamma swapped). We write H1 = |z/z_y|^n and
      * H2 = beta + gamma sgn(z eps') as in eq. 2.33.
      *
@@ -41,7 +41,7 @@ namespace hysteron
      * (sgn(z eps') < 0), so unloading is exactly elastic: z' = eps' / eta.
      *
      * <h3>Degradation (the project's dimensionally consistent form)</h3>
-     * The seed's eq. 2.41 and 2.45 define the intrinsic time xi with different
+     * The dissertation's eq. 2.41 and 2.45 define the intrinsic time xi with different
      * units (strain rate in 2.41, stress times strain rate in 2.45) and put
      * factors beta, nu_s and (z/z_y)^(n-1) in different places. We use the
      * endochronic form of Erlicher and Bursi with strain units throughout.
@@ -57,10 +57,10 @@ namespace hysteron
      *   e_h'  = (1 - a) k z (eps' - eta z'),          e_h(0) = 0,
      *   nu_s  = 1 + c_nu e_h / (y z_y)                (= 1 + c_nu e_h / (sigma_y eps_y)).
      *
-     * Mapping to the seed: eq. 2.42, eta' = c_eta eta^(-m_u) beta nu_s xi_seed',
-     * with xi_seed' = (1 + gamma/beta sgn(z eps')) H1 |eps'| (eq. 2.45 with the
+     * Mapping to the dissertation: eq. 2.42, eta' = c_eta eta^(-m_u) beta nu_s xi_diss',
+     * with xi_diss' = (1 + gamma/beta sgn(z eps')) H1 |eps'| (eq. 2.45 with the
      * strain rate in place of sigma^T eps'), is exactly our eta' since
-     * beta (1 + gamma/beta sgn) = H2. eta is the seed's n_s of eq. 2.37-2.38, and
+     * beta (1 + gamma/beta sgn) = H2. eta is the dissertation's n_s of eq. 2.37-2.38, and
      * nu_s is eq. 2.38 with e_h normalised by the elastic energy density scale
      * y z_y = sigma_y^2 / E, so that c_nu is dimensionless. With Table 2-2
      * (c_eta = 30, m_u = 1, c_nu = 0.001, three cycles of 0.6 %) this gives
@@ -87,7 +87,7 @@ namespace hysteron
      * The rate equations are integrated in pseudo-time over the increment
      * (eps' = deps, so y(1) = y(0) + int_0^1 f(y) ds):
      * - forward euler: one evaluation at the start state (first order; stable
-     *   only for deps / z_y <~ 2 / n, DESIGN.md §3); a step that ends farther
+     *   only for deps / z_y <~ 2 / n, doc/theory.md); a step that ends farther
      *   beyond the saturation value z_s than one increment can reach from inside
      *   it (the scheme has become unstable, inf and NaN follow) is a RuntimeError;
      * - adaptive: Bogacki-Shampine 3(2) with first-same-as-last and error

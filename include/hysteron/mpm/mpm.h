@@ -8,7 +8,7 @@
 #include <hysteron/geometry/region.h>
 #include <hysteron/mpm/grid.h>
 #include <hysteron/mpm/particles.h>
-#include <hysteron/scene/method.h>
+#include <hysteron/run/stepping_method.h>
 #include <hysteron/scene/point_data.h>
 #include <hysteron/scene/tables.h>
 #include <hysteron/scene/scene.h>
@@ -50,10 +50,14 @@ namespace hysteron
      * the velocities p_i / m_i of step 1 before the forces are computed.
      *
      * The kernels are templates of the basis (linear, cubic B-spline): the
-     * basis and the scheme are chosen once per step.
+     * basis is chosen once, at set-up, and the scheme once per step.
+     *
+     * The run loop (time steps, outputs, checkpoints, signals) is the driver's
+     * (Run::SteppingMethod); this class implements the set-up, the step, the
+     * state and the fields.
      */
     template <int dim>
-    class Solver : public Methods::Interface<dim>
+    class Solver : public Run::SteppingMethod<dim>
     {
     public:
       Solver();
@@ -63,19 +67,58 @@ namespace hysteron
       declare_parameters(dealii::ParameterHandler &prm);
 
       void
-      run() override;
+      setup() override;
 
       std::string
       summary() const override;
 
+      std::string
+      checkpoint_unsupported() const override
+      {
+        return "";
+      }
+
       /// One step from t to t + dt with the basis @p Basis (a 1D kernel of basis.h).
       template <typename Basis>
       void
-      advance(const double t, const double dt);
+      step(const double t, const double dt);
 
     protected:
       void
       parse_parameters(dealii::ParameterHandler &prm) override;
+
+      // The driver's hooks.
+      std::string
+      label() const override
+      {
+        return "mpm";
+      }
+      std::string
+      field_name() const override
+      {
+        return "particles";
+      }
+      void
+      open_outputs() override;
+      void
+      initialize() override;
+      double
+      propose_step(double t) override;
+      bool
+      advance(double &t, double dt) override;
+      void
+      write_rows(double t) override
+      {
+        write_table_rows(t);
+      }
+      void
+      write_fields(double t, Output::FieldWriter &writer) override;
+      void
+      finish(double t) override;
+      void
+      save(Run::CheckpointWriter &out) const override;
+      void
+      load(Run::CheckpointReader &in) override;
 
     private:
       struct BoundaryNodes
@@ -130,8 +173,6 @@ namespace hysteron
       void
       check_step(const double dt, const double t) const;
       void
-      write_fields(const double t);
-      void
       open_tables();
       /// Column names and values of one point (probes, particle table).
       std::vector<std::string>
@@ -142,17 +183,12 @@ namespace hysteron
       write_particle_table() const;
       void
       write_table_rows(const double t);
-      void
-      commit_tables();
-      [[noreturn]] void
-      fail(const std::string &what, const double t);
       /// The failure of the last step, described on every rank (from the rank that saw it).
       std::string
       describe_failure(const double t) const;
-      /// Stops the run (through @p fail_at_t) if the step from @p t diverged (energy).
-      template <typename Fail>
-      void
-      check_energy(const double t, const double dt, const double critical, Fail &&fail_at_t);
+      /// The divergence message if the step from @p t diverged (energy), else "".
+      std::string
+      check_energy(const double t, const double dt, const double critical) const;
       void
       apply_boundary_conditions(const double t, const double dt, const bool record_reactions);
       bool
@@ -228,10 +264,9 @@ namespace hysteron
       bool         left_subdomain       = false;
 
       // Bookkeeping.
-      unsigned long                                 n_steps = 0;
-      unsigned int                                  n_outputs = 0;
+      /// The step kernel of the chosen basis (step<Linear1D> or step<CubicBSpline1D>).
+      void (Solver::*step_kernel)(double, double) = nullptr;
       unsigned int                                  n_rebuilds = 0;
-      std::unique_ptr<Output::FieldWriter>          field_writer;
       PointData::Tables<dim>                        tables;
       std::vector<std::string>                      state_names;
       std::vector<unsigned int>                     group_of_body;

@@ -11,7 +11,7 @@
 #include <hysteron/base/implicit_dynamics.h>
 #include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>
-#include <hysteron/base/progress.h>
+#include <hysteron/run/checkpoint.h>
 #include <hysteron/material/bouc_wen_interaction.h>
 #include <hysteron/material/bouc_wen_uniaxial.h>
 #include <hysteron/rbsn/tessellation.h>
@@ -20,6 +20,7 @@
 #include <hysteron/scene/tables.h>
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -128,11 +129,43 @@ namespace hysteron
       static void
       declare_parameters(dealii::ParameterHandler &prm);
 
+      // What the driver (Run::SteppingMethod, through Solver) calls.
+      /// The network, springs, system and conditions; writes no file.
       void
-      run();
-
+      setup();
+      /// The tables (newton.csv or ida.csv, fracture.csv and the point tables).
+      void
+      open_outputs();
+      /// Forces at t = 0, and the initial acceleration in dynamics.
+      void
+      initialize();
+      double
+      propose_step(double t);
+      /// One increment with its fracture cycles (or, with variable order, the whole
+      /// integration, reporting each output time to @p step_finished).
+      bool
+      advance(double &t, double dt, const std::function<void(double)> &step_finished);
+      void
+      write_rows(const double t)
+      {
+        write_table_rows(t);
+      }
+      void
+      write_fields(double t, Output::FieldWriter &writer);
+      /// springs.csv when asked for.
+      void
+      finish();
+      /// Why this analysis cannot be checkpointed ("" if it can).
       std::string
-      summary() const;
+      checkpoint_unsupported() const;
+      void
+      save(Run::CheckpointWriter &out) const;
+      void
+      load(Run::CheckpointReader &in);
+
+      /// The run's summary, with the driver's counts.
+      std::string
+      summary(unsigned long steps, unsigned int outputs) const;
 
       const Tessellation &
       tessellation() const
@@ -215,17 +248,16 @@ namespace hysteron
       /// The fracture.csv row of a break of @p facet at time @p t (its trial forces).
       std::vector<double>
       break_row(const unsigned int facet, const double t) const;
+      /// The cell and facet of every probe point (a point outside the bodies is refused).
+      void
+      locate_probes();
       void
       open_tables();
-      void
-      commit_tables();
       void
       write_spring_table() const;
       /// The probe / average values of cell @p c and facet @p e (-1: none) into @p out.
       void
       point_values(const unsigned int c, const int e, const dealii::Point<2> &x, double *out) const;
-      [[noreturn]] void
-      fail(const std::string &what, const double t);
 
       // Analysis = variable order (variable_order.cc): the DAE in (u, v, s) and IDA.
       class VariableOrder;
@@ -233,19 +265,17 @@ namespace hysteron
       declare_variable_order_parameters(dealii::ParameterHandler &prm);
       void
       parse_variable_order_parameters(dealii::ParameterHandler &prm);
-      /// Integrate from 0 to the end time, writing the tables and fields at the output
-      /// times k @p output_interval; returns the end time.
+      /// Integrate from 0 to the end time, reporting the output times k @p output_interval
+      /// to @p step_finished (the driver writes tables and fields there); returns the end time.
       double
-      integrate_variable_order(const double output_interval, PointData::Schedule &rows,
-                               PointData::Schedule &fields, Progress &progress);
+      integrate_variable_order(const double output_interval,
+                               const std::function<void(double)> &step_finished);
 
       // Output.
       std::vector<std::string>
       point_columns() const;
       void
       write_table_rows(const double t);
-      void
-      write_fields(const double t);
       void
       write_vtu(std::ostream &out) const;
 
@@ -296,11 +326,13 @@ namespace hysteron
       // Bookkeeping.
       PointData::Tables<2>                 tables;
       /// newton.csv (Newton's iterations), ida.csv with variable order (the integrator's statistics)
-      std::unique_ptr<Output::CsvWriter>   newton_table, fracture_table;
-      std::unique_ptr<Output::FieldWriter> field_writer;
+      std::unique_ptr<Output::TimeTable>   newton_table, fracture_table;
+      /// The load increments (cuts and recovery).
+      IncrementControl increments{1.0, 0};
       double internal_work = 0, external_work = 0, boundary_work = 0;
-      unsigned long n_steps = 0, n_newton = 0, n_broken = 0;
-      unsigned int  n_outputs = 0, n_cuts = 0;
+      unsigned long n_steps = 0; ///< variable order: IDA's steps
+      unsigned long n_newton = 0, n_broken = 0;
+      unsigned int  n_cuts = 0;
       std::string   spring_failure;
       std::vector<int>              probe_cell, probe_facet;
     };

@@ -1,7 +1,7 @@
 #ifndef hysteron_rbsn_rbsn_h
 #define hysteron_rbsn_rbsn_h
 
-#include <hysteron/scene/method.h>
+#include <hysteron/run/stepping_method.h>
 
 #include <memory>
 #include <string>
@@ -27,7 +27,7 @@ namespace hysteron
      * refused.
      */
     template <int dim>
-    class Solver : public Methods::Interface<dim>
+    class Solver : public Run::SteppingMethod<dim>
     {
     public:
       Solver();
@@ -37,14 +37,47 @@ namespace hysteron
       declare_parameters(dealii::ParameterHandler &prm);
 
       void
-      run() override;
+      setup() override;
 
       std::string
       summary() const override;
 
+      std::string
+      checkpoint_unsupported() const override;
+
     protected:
       void
       parse_parameters(dealii::ParameterHandler &prm) override;
+
+      // The driver's hooks, forwarded to the Model.
+      std::string
+      label() const override
+      {
+        return "rbsn";
+      }
+      std::string
+      field_name() const override
+      {
+        return "rbsn";
+      }
+      void
+      open_outputs() override;
+      void
+      initialize() override;
+      double
+      propose_step(double t) override;
+      bool
+      advance(double &t, double dt) override;
+      void
+      write_rows(double t) override;
+      void
+      write_fields(double t, Output::FieldWriter &writer) override;
+      void
+      finish(double t) override;
+      void
+      save(Run::CheckpointWriter &out) const override;
+      void
+      load(Run::CheckpointReader &in) override;
 
     private:
       std::unique_ptr<Model> model;

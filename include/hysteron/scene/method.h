@@ -39,6 +39,22 @@ namespace hysteron
         parse_parameters(prm);
       }
 
+      /**
+       * Build everything the run needs (grids, bodies, networks, conditions) and
+       * refuse bad input (InputError). Writes no file: the output directory is
+       * prepared only after a successful set-up, so a refused run leaves nothing.
+       */
+      virtual void
+      setup()
+      {}
+
+      /// "" if the method writes checkpoints (and can resume) in this scene, else why not.
+      virtual std::string
+      checkpoint_unsupported() const
+      {
+        return "this method does not write checkpoints";
+      }
+
       /// Run the scene to the end, writing outputs into the scene's directory.
       virtual void
       run() = 0;

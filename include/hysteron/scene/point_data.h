@@ -8,6 +8,7 @@
 
 #include <hysteron/material/interface.h>
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -95,6 +96,21 @@ namespace hysteron
           double internal_work,
           double external_work,
           double boundary_work);
+
+      /// The reference state (t = 0), for a checkpoint.
+      std::array<double, 3>
+      state() const
+      {
+        return {{started ? 1.0 : 0.0, initial_kinetic, initial_strain}};
+      }
+
+      void
+      restore(const std::array<double, 3> &s)
+      {
+        started         = s[0] != 0;
+        initial_kinetic = s[1];
+        initial_strain  = s[2];
+      }
 
     private:
       bool   started         = false;

@@ -46,11 +46,27 @@ namespace hysteron
     std::vector<Geometry::Region<dim>> average_regions;
   };
 
+  /// `subsection Checkpoint`: when a time-stepping method saves its state.
+  struct CheckpointControl
+  {
+    unsigned int interval     = 0; ///< steps between checkpoints, 0: none
+    double       wall_minutes = 0; ///< wall-clock minutes between checkpoints, 0: none
+    unsigned int keep         = 2; ///< the newest checkpoints kept
+
+    bool
+    enabled() const
+    {
+      return interval > 0 || wall_minutes > 0;
+    }
+  };
+
   /// How the executable was called.
   struct RunOptions
   {
     std::string parameter_file;
-    bool        quiet = false;
+    std::string command_line; ///< for the run's manifest
+    bool        quiet  = false;
+    bool        resume = false; ///< --resume: continue from the newest checkpoint
     MPI_Comm    comm  = MPI_COMM_WORLD;
   };
 
@@ -123,6 +139,33 @@ namespace hysteron
       return output;
     }
 
+    const CheckpointControl &
+    checkpoint_control() const
+    {
+      return checkpoint;
+    }
+
+    /// `hysteron --resume`: continue from the newest checkpoint.
+    bool
+    resume() const
+    {
+      return options.resume;
+    }
+
+    /// The registered name of the scene's method ("mpm").
+    const std::string &
+    method_name() const
+    {
+      return method_name_;
+    }
+
+    /// Every parameter of the run, defaults included (parameters.prm).
+    const std::string &
+    effective_parameters() const
+    {
+      return effective_parameters_;
+    }
+
     /// "<Output/Directory>/<file>".
     std::string
     output_file(const std::string &file) const
@@ -191,7 +234,7 @@ namespace hysteron
     /// Created first and destroyed while a parse error is still caught: a
     /// TimerOutput destroyed during stack unwinding prints a warning.
     mutable std::optional<dealii::TimerOutput>                      computing_timer;
-    std::string                                                     method_name;
+    std::string                                                     method_name_;
     std::map<std::string, std::unique_ptr<Material::Interface<dim>>> materials;
     std::vector<BodyDescription<dim>>                               bodies;
     std::vector<BoundaryDescription<dim>>                           boundaries;
@@ -199,8 +242,9 @@ namespace hysteron
     dealii::Tensor<1, dim>                                          gravity_vector;
     TimeControl                                                     time;
     OutputControl<dim>                                              output;
+    CheckpointControl                                               checkpoint;
     unsigned int                                                    seed = 0;
-    std::string                                                     effective_parameters;
+    std::string                                                     effective_parameters_;
     std::unique_ptr<Methods::Interface<dim>>                        method;
   };
 

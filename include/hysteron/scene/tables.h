@@ -5,6 +5,7 @@
 #include <deal.II/base/tensor.h>
 
 #include <hysteron/base/output.h>
+#include <hysteron/run/checkpoint.h>
 #include <hysteron/scene/point_data.h>
 
 #include <array>
@@ -59,13 +60,19 @@ namespace hysteron
             std::vector<dealii::Tensor<1, dim>>  reactions,
             const MPI_Comm                       comm);
 
-      /// Commit (rename) every table (rank 0).
+      /// Write the buffered rows of every table (rank 0).
       void
-      commit();
+      flush();
+
+      /// The state between rows (the last row's time, the energy reference).
+      void
+      save(Run::CheckpointWriter &out) const;
+      void
+      load(Run::CheckpointReader &in);
 
     private:
-      std::vector<std::unique_ptr<Output::CsvWriter>> probe_tables, average_tables;
-      std::unique_ptr<Output::CsvWriter>              energy_table, reaction_table;
+      std::vector<std::unique_ptr<Output::TimeTable>> probe_tables, average_tables;
+      std::unique_ptr<Output::TimeTable>              energy_table, reaction_table;
       EnergyLog                                       energy_log;
       unsigned int                                    n_values = 0;
       /// The time of the last row (a failing run writes its last good state, which
@@ -87,6 +94,20 @@ namespace hysteron
         , next(interval)
         , eps(1e-12 * end_time)
       {}
+
+      /// The time of the next output (for a checkpoint).
+      double
+      next_time() const
+      {
+        return next;
+      }
+
+      /// Resume: the next output is at @p t.
+      void
+      restart(const double t)
+      {
+        next = t;
+      }
 
       /// After a step that ended at @p t (the last one if @p last): is an output due?
       bool

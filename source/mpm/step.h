@@ -1,8 +1,8 @@
-#ifndef hysteron_mpm_step_h
-#define hysteron_mpm_step_h
+#ifndef hysteron_source_mpm_step_h
+#define hysteron_source_mpm_step_h
 
 // The kernels of one MPM step, templates of the 1D basis kernel. Included only
-// by source/mpm/step_*.cc, which instantiate Solver<dim>::advance<Basis>.
+// by source/mpm/step_*.cc, which instantiate Solver<dim>::step<Basis>.
 
 #include <hysteron/mpm/mpm.h>
 
@@ -90,7 +90,7 @@ namespace hysteron
     template <int dim>
     template <typename Basis>
     void
-    Solver<dim>::advance(const double t, const double dt)
+    Solver<dim>::step(const double t, const double dt)
     {
       using namespace dealii;
       using Support = internal::Support<dim, Basis>;

@@ -1,0 +1,98 @@
+// The RBSN's part of a checkpoint: the DoF vectors, every facet's springs (converged
+// and trial state, tangent, broken or not), the increment control and the work sums.
+// Every rank holds the whole network, so every rank writes (and reads) the same.
+#include <hysteron/rbsn/model.h>
+
+namespace hysteron
+{
+  namespace RBSN
+  {
+    void
+    Model::save(Run::CheckpointWriter &out) const
+    {
+      const auto put_vector = [&](const Vector &x) {
+        out.put(std::vector<double>(x.begin(), x.end()));
+      };
+      out.section("rbsn vectors");
+      out.put<std::uint64_t>(u.size());
+      for (const Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia,
+                              &reaction_old})
+        put_vector(*x);
+      out.section("rbsn springs");
+      out.put<std::uint64_t>(springs.size());
+      for (const auto &sp : springs)
+        {
+          out.put(sp.delta);
+          out.put(sp.force);
+          out.put(sp.trial_delta);
+          out.put(sp.trial_force);
+          out.put(sp.tangent);
+          out.put(sp.state);
+          out.put(sp.trial_state);
+          out.put(sp.tangent_matrix);
+          out.put(sp.broken);
+        }
+      out.section("rbsn sums");
+      out.put(force_scale);
+      out.put(last_force_level);
+      out.put(predictor_level);
+      out.put(internal_work);
+      out.put(external_work);
+      out.put(boundary_work);
+      out.put(n_steps);
+      out.put(n_newton);
+      out.put(n_broken);
+      out.put(n_cuts);
+      out.put(increments.state());
+      tables.save(out);
+    }
+
+
+
+    void
+    Model::load(Run::CheckpointReader &in)
+    {
+      const auto get_vector = [&](Vector &x) {
+        std::vector<double> values;
+        in.get(values);
+        if (values.size() != x.size())
+          in.refuse("the network has another number of DoFs than the checkpoint's");
+        std::copy(values.begin(), values.end(), x.begin());
+      };
+      in.section("rbsn vectors");
+      if (in.get<std::uint64_t>() != u.size())
+        in.refuse("the network has another number of DoFs than the checkpoint's (the same "
+                  "parameters and Random seed give the same network)");
+      for (Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
+        get_vector(*x);
+      in.section("rbsn springs");
+      if (in.get<std::uint64_t>() != springs.size())
+        in.refuse("the network has another number of facets than the checkpoint's");
+      for (auto &sp : springs)
+        {
+          in.get(sp.delta);
+          in.get(sp.force);
+          in.get(sp.trial_delta);
+          in.get(sp.trial_force);
+          in.get(sp.tangent);
+          in.get(sp.state);
+          in.get(sp.trial_state);
+          in.get(sp.tangent_matrix);
+          in.get(sp.broken);
+        }
+      in.section("rbsn sums");
+      in.get(force_scale);
+      in.get(last_force_level);
+      in.get(predictor_level);
+      in.get(internal_work);
+      in.get(external_work);
+      in.get(boundary_work);
+      in.get(n_steps);
+      in.get(n_newton);
+      in.get(n_broken);
+      in.get(n_cuts);
+      increments.restore(in.get<std::array<double, 4>>());
+      tables.load(in);
+    }
+  } // namespace RBSN
+} // namespace hysteron

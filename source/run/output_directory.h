@@ -1,0 +1,62 @@
+#ifndef hysteron_source_run_output_directory_h
+#define hysteron_source_run_output_directory_h
+
+#include <mpi.h>
+
+#include <string>
+
+namespace hysteron
+{
+  namespace Run
+  {
+    /// What the manifest says of the run.
+    struct RunDescription
+    {
+      std::string command;        ///< the command line
+      std::string parameter_file;
+      std::string method;
+      unsigned int n_ranks = 1;
+    };
+
+    /**
+     * The output directory of a run, kept safe from other runs:
+     *  - a lock (`.hysteron.lock`, flock): a second run into a directory in use is
+     *    refused with a message naming the running process; the lock goes with
+     *    the process, even when it is killed;
+     *  - a manifest (`manifest.json`): the command, version, commit, ranks, start,
+     *    status and every file the run wrote, rewritten when a file is added;
+     *  - hygiene: the files that the previous run's manifest lists are removed
+     *    before a new run writes (not on --resume), so nothing stale looks current.
+     * Rank 0 does the work; every rank learns of a problem (an InputError).
+     */
+    class OutputDirectory
+    {
+    public:
+      /// Before set-up: refuse a directory that a running process holds. Creates nothing.
+      static void
+      check_not_in_use(const std::string &directory, MPI_Comm comm);
+
+      /// After set-up: create, lock, clean (a new run) and start the manifest.
+      void
+      open(const std::string &directory, const RunDescription &run, bool resume, MPI_Comm comm);
+
+      /// The end of the run: "finished", "failed", "interrupted"; then unlock.
+      void
+      close(const std::string &status, const std::string &message);
+
+      ~OutputDirectory();
+
+    private:
+      void
+      write_manifest() const;
+
+      std::string    directory;
+      RunDescription run;
+      bool           root = false;
+      int            lock_fd = -1;
+      std::string    started, status = "running", message, resumed;
+    };
+  } // namespace Run
+} // namespace hysteron
+
+#endif

@@ -1,0 +1,247 @@
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/timer.h>
+
+#include <hysteron/base/exceptions.h>
+#include <hysteron/base/progress.h>
+#include <hysteron/base/run_record.h>
+#include <hysteron/run/stepping_method.h>
+#include <hysteron/scene/scene.h>
+#include <hysteron/scene/tables.h>
+
+#include "run/checkpoint_files.h"
+#include "run/signals.h"
+
+#include <csignal>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+namespace hysteron
+{
+  namespace Run
+  {
+    namespace
+    {
+      std::string
+      seconds(const double t)
+      {
+        std::ostringstream s;
+        s << std::setprecision(6) << t;
+        return s.str();
+      }
+
+    } // namespace
+
+    /// The driver's state during run(): what step_finished() needs.
+    template <int dim>
+    struct SteppingMethod<dim>::Loop
+    {
+      Loop(const Scene<dim> &scene, const std::string &label)
+        : rows(scene.output_control().probe_interval, scene.time_control().end_time)
+        , fields(scene.output_control().interval, scene.time_control().end_time)
+        , progress(scene.console(),
+                   label,
+                   scene.time_control().end_time,
+                   scene.output_control().progress_interval)
+      {
+        wall.start();
+      }
+
+      PointData::Schedule rows, fields;
+      Progress            progress;
+      dealii::Timer       wall;
+      double              last_checkpoint = 0;
+      double              time            = 0; ///< of the last finished step (the last good state)
+    };
+
+    template <int dim>
+    SteppingMethod<dim>::SteppingMethod() = default;
+
+    template <int dim>
+    SteppingMethod<dim>::~SteppingMethod() = default;
+
+    template <int dim>
+    void
+    SteppingMethod<dim>::output_fields(const double t)
+    {
+      const Scene<dim> &scene = this->get_scene();
+      if (!scene.output_control().write_vtu)
+        return;
+      dealii::TimerOutput::Scope timing(scene.timer(), "output");
+      write_fields(t, *field_writer);
+      ++outputs;
+    }
+
+    template <int dim>
+    void
+    SteppingMethod<dim>::write_last_state()
+    {
+      output_fields(loop->time);
+      write_rows(loop->time);
+      Output::RunRecord::get().flush_tables();
+    }
+
+    template <int dim>
+    void
+    SteppingMethod<dim>::save_checkpoint()
+    {
+      const Scene<dim> &scene = this->get_scene();
+      auto             &record = Output::RunRecord::get();
+      dealii::TimerOutput::Scope timing(scene.timer(), "checkpoint");
+      record.flush_tables();
+      const auto sizes = record.table_sizes();
+      const double t   = loop->time;
+      write_checkpoint(this->output_directory(),
+                       steps,
+                       t,
+                       scene.mpi_communicator(),
+                       scene.checkpoint_control().keep,
+                       [&](CheckpointWriter &out) {
+                         write_resume_header(out, scene.method_name(), scene.effective_parameters());
+                         out.put(t);
+                         out.put(steps);
+                         out.put(outputs);
+                         out.put(loop->rows.next_time());
+                         out.put(loop->fields.next_time());
+                         out.put(field_writer->records());
+                         out.put(sizes);
+                         out.section(label());
+                         save(out);
+                       });
+      loop->last_checkpoint = loop->wall.wall_time();
+    }
+
+    template <int dim>
+    void
+    SteppingMethod<dim>::step_finished(const double t)
+    {
+      const Scene<dim>  &scene   = this->get_scene();
+      const auto        &control = scene.checkpoint_control();
+      MPI_Comm           comm    = scene.mpi_communicator();
+      const unsigned int n_ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
+      const double       end     = scene.time_control().end_time;
+      loop->time = t;
+      ++steps;
+      const bool last = !(t < end - 1e-12 * end);
+      if (loop->rows.due(t, last))
+        write_rows(t);
+      if (loop->fields.due(t, last))
+        output_fields(t);
+      loop->progress.update(steps, t);
+      test_signal_after_step(steps);
+
+      // One reduction (on several ranks) decides signals and wall-clock checkpoints.
+      bool wall_due = scene.is_root() && control.wall_minutes > 0 &&
+                      loop->wall.wall_time() - loop->last_checkpoint >= 60 * control.wall_minutes;
+      const int  signal   = received_signal(comm, n_ranks, wall_due);
+      const bool step_due = control.interval > 0 && steps % control.interval == 0;
+      if (signal != 0 || (!last && (step_due || wall_due)))
+        save_checkpoint();
+      if (signal != 0)
+        {
+          // The checkpoint holds the tables without the rows written now: a resumed
+          // run's tables equal an uninterrupted run's.
+          write_last_state();
+          loop->progress.finish(steps, t);
+          throw Interrupted(
+            std::string(signal == SIGINT ? "SIGINT" : "SIGTERM") + " received: " + label() +
+            " stopped after step " + std::to_string(steps) + " at t = " + seconds(t) +
+            " s; the state was written (tables, a VTU and a checkpoint). Continue with: " +
+            (n_ranks > 1 ? "mpirun -np " + std::to_string(n_ranks) + " " : std::string()) +
+            "hysteron --resume " + scene.parameter_file());
+        }
+    }
+
+    template <int dim>
+    void
+    SteppingMethod<dim>::run()
+    {
+      const Scene<dim>  &scene     = this->get_scene();
+      const auto        &time      = scene.time_control();
+      MPI_Comm           comm      = scene.mpi_communicator();
+      const std::string  name      = label();
+      const std::string  directory = this->output_directory();
+      auto              &record    = Output::RunRecord::get();
+      loop = std::make_unique<Loop>(scene, name);
+      double t = 0;
+
+      // Resume: the driver's part of the checkpoint comes first, since the tables
+      // must know their lengths before the method opens them.
+      ResumeSource resume;
+      std::vector<std::pair<double, std::string>> field_records;
+      if (scene.resume())
+        {
+          resume = open_resume(directory, scene.method_name(), scene.effective_parameters(), comm);
+          auto &reader = resume.reader;
+          reader->get(t);
+          reader->get(steps);
+          reader->get(outputs);
+          double next_row, next_field;
+          reader->get(next_row);
+          reader->get(next_field);
+          loop->rows.restart(next_row);
+          loop->fields.restart(next_field);
+          reader->get(field_records);
+          std::map<std::string, std::uint64_t> sizes;
+          reader->get(sizes);
+          record.set_resume_sizes(sizes);
+        }
+
+      open_outputs();
+      field_writer = std::make_unique<Output::FieldWriter>(directory, field_name(), comm);
+      record.set_resume_sizes({});
+      loop->time = t;
+      if (auto &reader = resume.reader)
+        {
+          field_writer->restore(field_records);
+          reader->section(name);
+          load(*reader);
+          scene.console() << name << ": resumed from " << resume.file.directory << " at t = "
+                          << seconds(t) << " s (step " << steps << ")" << std::endl;
+        }
+      else
+        {
+          initialize();
+          output_fields(t);
+          write_rows(t);
+        }
+
+      const double eps = 1e-12 * time.end_time;
+      install_signal_handlers();
+      try
+        {
+          while (t < time.end_time - eps)
+            {
+              bool accepted = false;
+              try
+                {
+                  const double dt = propose_step(t);
+                  dealii::TimerOutput::Scope timing(scene.timer(), "steps");
+                  accepted = advance(t, dt);
+                }
+              catch (const StepFailure &failure)
+                {
+                  // The state of the last finished step (loop->time) is the last good one.
+                  write_last_state();
+                  throw RuntimeError(std::string(failure.what()) + " The last good state (t = " +
+                                     seconds(loop->time) + " s) was written.");
+                }
+              if (accepted)
+                step_finished(t);
+            }
+        }
+      catch (...)
+        {
+          restore_signal_handlers();
+          throw;
+        }
+      restore_signal_handlers();
+      loop->progress.finish(steps, t);
+      finish(t);
+      record.flush_tables();
+    }
+
+    template class SteppingMethod<2>;
+    template class SteppingMethod<3>;
+  } // namespace Run
+} // namespace hysteron
