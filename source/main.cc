@@ -1,7 +1,7 @@
-// The `hysteron` executable: MPI set-up, then the command line (scene/application.h).
+// The `hysteron` executable: MPI set-up, then the command line (run/application.h).
 #include <deal.II/base/mpi.h>
 
-#include <hysteron/scene/application.h>
+#include <hysteron/run/application.h>
 
 int
 main(int argc, char **argv)

@@ -11,7 +11,7 @@ namespace hysteron
     {
       template <typename VectorType>
       void
-      put_owned(Run::CheckpointWriter &out, const VectorType &v, const dealii::IndexSet &owned)
+      put_owned(CheckpointWriter &out, const VectorType &v, const dealii::IndexSet &owned)
       {
         std::vector<double> values;
         values.reserve(owned.n_elements());
@@ -22,7 +22,7 @@ namespace hysteron
 
       template <typename VectorType>
       void
-      get_owned(Run::CheckpointReader &in, VectorType &v, const dealii::IndexSet &owned)
+      get_owned(CheckpointReader &in, VectorType &v, const dealii::IndexSet &owned)
       {
         std::vector<double> values;
         in.get(values);
@@ -37,7 +37,7 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::save(Run::CheckpointWriter &out) const
+    Solver<dim>::save(CheckpointWriter &out) const
     {
       out.section("fem vectors");
       out.put<std::uint64_t>(dof_handler.n_dofs());
@@ -77,7 +77,7 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::load(Run::CheckpointReader &in)
+    Solver<dim>::load(CheckpointReader &in)
     {
       in.section("fem vectors");
       if (in.get<std::uint64_t>() != dof_handler.n_dofs())
@@ -120,9 +120,9 @@ namespace hysteron
       tables.load(in);
     }
 
-    template void Solver<2>::save(Run::CheckpointWriter &) const;
-    template void Solver<3>::save(Run::CheckpointWriter &) const;
-    template void Solver<2>::load(Run::CheckpointReader &);
-    template void Solver<3>::load(Run::CheckpointReader &);
+    template void Solver<2>::save(CheckpointWriter &) const;
+    template void Solver<3>::save(CheckpointWriter &) const;
+    template void Solver<2>::load(CheckpointReader &);
+    template void Solver<3>::load(CheckpointReader &);
   } // namespace FEM
 } // namespace hysteron

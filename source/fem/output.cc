@@ -85,10 +85,8 @@ namespace hysteron
       const Scene<dim> &scene = this->get_scene();
       tables.open(scene, this->output_directory(), PointData::columns<dim>(state_names));
       if (scene.is_root() && analysis != Analysis::explicit_dynamics)
-        newton_table = std::make_unique<Output::TimeTable>(
-          this->output_file("newton.csv"),
-          std::vector<std::string>{"time", "step", "iteration", "residual", "force_level",
-                                   "relative_residual", "line_search"});
+        newton_table = std::make_unique<Output::TimeTable>(this->output_file("newton.csv"),
+                                                           newton_columns());
     }
 
 
@@ -102,11 +100,7 @@ namespace hysteron
                             const double       alpha)
     {
       if (newton_table)
-        {
-          const double level = force_level();
-          newton_table->add_row(
-            {t1, dt, double(iteration), residual, level, level > 0 ? residual / level : 0.0, alpha});
-        }
+        newton_table->add_row(newton_row(t1, dt, iteration, residual, force_level(), alpha));
     }
 
 

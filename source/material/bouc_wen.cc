@@ -1,5 +1,7 @@
 #include <hysteron/material/bouc_wen.h>
 
+#include "material/bouc_wen_kernels.h"
+
 #include <cmath>
 #include <type_traits>
 

@@ -11,7 +11,7 @@ namespace hysteron
   {
     template <int dim>
     void
-    Solver<dim>::save(Run::CheckpointWriter &out) const
+    Solver<dim>::save(CheckpointWriter &out) const
     {
       const auto &P = particles;
       out.section("mpm points");
@@ -62,7 +62,7 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::load(Run::CheckpointReader &in)
+    Solver<dim>::load(CheckpointReader &in)
     {
       using namespace dealii;
       auto &P = particles;
@@ -172,9 +172,9 @@ namespace hysteron
       failed_point   = -1;
     }
 
-    template void Solver<2>::save(Run::CheckpointWriter &) const;
-    template void Solver<3>::save(Run::CheckpointWriter &) const;
-    template void Solver<2>::load(Run::CheckpointReader &);
-    template void Solver<3>::load(Run::CheckpointReader &);
+    template void Solver<2>::save(CheckpointWriter &) const;
+    template void Solver<3>::save(CheckpointWriter &) const;
+    template void Solver<2>::load(CheckpointReader &);
+    template void Solver<3>::load(CheckpointReader &);
   } // namespace MPM
 } // namespace hysteron

@@ -8,7 +8,7 @@ namespace hysteron
   namespace RBSN
   {
     void
-    Model::save(Run::CheckpointWriter &out) const
+    Model::save(CheckpointWriter &out) const
     {
       const auto put_vector = [&](const Vector &x) {
         out.put(std::vector<double>(x.begin(), x.end()));
@@ -50,7 +50,7 @@ namespace hysteron
 
 
     void
-    Model::load(Run::CheckpointReader &in)
+    Model::load(CheckpointReader &in)
     {
       const auto get_vector = [&](Vector &x) {
         std::vector<double> values;

@@ -4,6 +4,7 @@
 #include <hysteron/base/parameters.h>
 #include <hysteron/material/bouc_wen.h>
 #include <hysteron/rbsn/model.h>
+#include <hysteron/scene/output_column.h>
 #include <hysteron/rbsn/rbsn.h>
 
 #include <cmath>
@@ -670,6 +671,11 @@ namespace hysteron
     void
     Solver<dim>::parse_parameters(dealii::ParameterHandler &prm)
     {
+      // The network's tables have cell and facet columns, not continuum points.
+      require(PointData::additional_columns<dim>().empty(),
+              "Output/Additional columns",
+              "the rbsn method's probe tables hold cell and facet values; additional point "
+              "columns apply to the mpm and fem methods");
       if constexpr (dim == 2)
         model = std::make_unique<Model>(this->get_scene(), *this, prm);
       else
@@ -746,14 +752,14 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::save(Run::CheckpointWriter &out) const
+    Solver<dim>::save(CheckpointWriter &out) const
     {
       model->save(out);
     }
 
     template <int dim>
     void
-    Solver<dim>::load(Run::CheckpointReader &in)
+    Solver<dim>::load(CheckpointReader &in)
     {
       model->load(in);
     }

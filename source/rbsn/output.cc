@@ -92,10 +92,8 @@ namespace hysteron
                                    "nonlinear_iterations", "error_test_failures",
                                    "convergence_failures"});
       else if (analysis != Analysis::linear_static)
-        newton_table = std::make_unique<Output::TimeTable>(
-          method.output_file("newton.csv"),
-          std::vector<std::string>{"time", "step", "iteration", "residual", "force_level",
-                                   "relative_residual", "line_search"});
+        newton_table =
+          std::make_unique<Output::TimeTable>(method.output_file("newton.csv"), newton_columns());
       if (fracture.enabled)
         fracture_table = std::make_unique<Output::TimeTable>(
           method.output_file("fracture.csv"),

@@ -263,57 +263,24 @@ namespace hysteron
       if (!assemble(t1, dt, true, true))
         return false;
       if (newton_table)
-        newton_table->add_row({t1, dt, 0.0, rhs.l2_norm(), force_level(), rhs.l2_norm() / std::max(force_level(), 1e-300), 1.0});
+        newton_table->add_row(newton_row(t1, dt, 0, rhs.l2_norm(), force_level(), 1.0));
 
-      struct Problem : NewtonProblem
-      {
-        Model       &m;
-        double       t1, dt;
-        Vector       du, start;
-        Problem(Model &m, const double t1, const double dt)
-          : m(m), t1(t1), dt(dt), du(m.u.size()), start(m.u.size())
-        {}
-        bool
-        evaluate(const bool with_matrix) override
-        {
-          return m.assemble(t1, dt, with_matrix, true);
-        }
-        double
-        residual() const override
-        {
-          return m.rhs.l2_norm();
-        }
-        double
-        force_level() const override
-        {
-          return m.force_level();
-        }
-        void
-        solve_correction() override
-        {
-          m.solve_linear(du);
-          m.constraints.distribute(du);
-        }
-        void
-        remember_start() override
-        {
-          start = m.u_trial;
-        }
-        void
-        move(const double alpha) override
-        {
-          m.u_trial = start;
-          m.u_trial.add(alpha, du);
-        }
-        void
-        log(const unsigned int iteration, const double residual, const double alpha) override
-        {
-          if (m.newton_table)
-            m.newton_table->add_row({t1, dt, double(iteration), residual, force_level(),
-                                     residual / std::max(force_level(), 1e-300), alpha});
-        }
-      } problem(*this, t1, dt);
-      const double       floor      = 64 * std::numeric_limits<double>::epsilon() * std::sqrt(double(u.size()));
+      Vector     correction(u.size());
+      const auto log = [&](const unsigned int iteration, const double residual, const double alpha) {
+        if (newton_table)
+          newton_table->add_row(newton_row(t1, dt, iteration, residual, force_level(), alpha));
+      };
+      VectorNewtonProblem<Vector> problem(u_trial,
+                                          correction,
+                                          {[&](const bool matrix) { return assemble(t1, dt, matrix, true); },
+                                           [&]() { return rhs.l2_norm(); },
+                                           [&]() { return force_level(); },
+                                           [&](Vector &x) {
+                                             solve_linear(x);
+                                             constraints.distribute(x);
+                                           },
+                                           log});
+      const double       floor      = residual_floor(u.size());
       const unsigned int iterations = newton_iterate(problem, newton, floor);
       n_newton += iterations > 0 ? iterations : newton.max_iterations;
       return iterations > 0;

@@ -1,7 +1,7 @@
 #ifndef hysteron_source_run_checkpoint_files_h
 #define hysteron_source_run_checkpoint_files_h
 
-#include <hysteron/run/checkpoint.h>
+#include <hysteron/base/checkpoint.h>
 
 #include <mpi.h>
 

@@ -1,3 +1,4 @@
+#include <hysteron/scene/output_column.h>
 #include <hysteron/scene/point_data.h>
 #include <hysteron/scene/scene.h>
 
@@ -30,6 +31,9 @@ namespace hysteron
             c.push_back("von_mises");
         }
       c.insert(c.end(), state_names.begin(), state_names.end());
+      for (const auto &column : additional_columns<dim>())
+        for (const auto &name : column->names())
+          c.push_back(name);
       return c;
     }
 
@@ -75,6 +79,10 @@ namespace hysteron
         out[c++] = strain[dealii::SymmetricTensor<2, dim>::unrolled_to_component_indices(k)];
       for (unsigned int k = 0; k < n_state_columns; ++k)
         out[c++] = (material != nullptr && k < state.size()) ? state[k] : 0.0;
+      // The plugins of `Output/Additional columns`.
+      if (!additional_columns<dim>().empty())
+        evaluate_additional_columns<dim>({x, u, v, stress, strain, material, state, sigma_zz},
+                                         out + c);
     }
 
 

@@ -3,10 +3,8 @@
 #include <hysteron/base/config.h>
 #include <hysteron/base/output.h>
 #include <hysteron/base/parameters.h>
+#include <hysteron/scene/output_column.h>
 #include <hysteron/scene/scene.h>
-
-#include "run/checkpoint_files.h"
-#include "run/output_directory.h"
 
 #include <filesystem>
 #include <iostream>
@@ -121,6 +119,14 @@ namespace hysteron
                         Patterns::Double(),
                         "Simulated time between rows of the probe, average, energy and reaction "
                         "tables [s], >= 0; 0: every step (field methods).");
+      prm.declare_entry("Additional columns",
+                        "",
+                        Patterns::MultipleSelection(PointData::ColumnRegistry<3>::pattern_string()),
+                        "Output column plugins appended to every point table of the mpm and fem "
+                        "methods (probe_<i>.csv, average_<i>.csv, particles.csv, "
+                        "quadrature_points.csv), in the order given. Registered columns:" +
+                          PointData::ColumnRegistry<3>::documentation());
+      PointData::ColumnRegistry<3>::declare_parameters(prm);
       prm.declare_entry("Average regions",
                         "",
                         Patterns::Anything(),
@@ -249,6 +255,8 @@ namespace hysteron
       output.probe_points      = parse_points<dim>(s.get("Probe points"), s.where("Probe points"));
       output.progress_interval = s.get_positive("Progress interval");
       output.probe_interval    = s.get_non_negative("Probe interval");
+      PointData::select_additional_columns<dim>(s.get_list("Additional columns"),
+                                                s.where("Additional columns"));
       for (const auto &expression :
            dealii::Utilities::split_string_list(s.get("Average regions"), ';'))
         if (!expression.empty())
@@ -328,71 +336,6 @@ namespace hysteron
     for (const auto &m : materials)
       names.push_back(m.first);
     return names;
-  }
-
-  template <int dim>
-  void
-  Scene<dim>::run()
-  {
-    const MPI_Comm comm = options.comm;
-    // A directory that another run is writing is refused before any work.
-    Run::OutputDirectory::check_not_in_use(output.directory, comm);
-    if (checkpoint.enabled() || options.resume)
-      {
-        const std::string why = method->checkpoint_unsupported();
-        require(why.empty(),
-                options.resume ? "--resume" : "Checkpoint",
-                "method '" + method_name_ + "': " + why);
-      }
-    if (options.resume)
-      {
-        // Refuse a missing or foreign checkpoint before the set-up.
-        Run::open_resume(method->output_directory(), method_name_, effective_parameters_, comm);
-      }
-
-    dealii::Timer wall;
-    wall.start();
-    pcout << "hysteron " HYSTERON_VERSION ": " << dim << "D scene '" << options.parameter_file
-          << "', method '" << method_name_ << "'" << std::endl;
-    {
-      dealii::TimerOutput::Scope timing(*computing_timer, "set-up");
-      method->setup();
-    }
-
-    // Only a scene that set up without a problem writes files.
-    Run::RunDescription description;
-    description.command        = options.command_line;
-    description.parameter_file = options.parameter_file;
-    description.method         = method_name_;
-    description.n_ranks        = dealii::Utilities::MPI::n_mpi_processes(comm);
-    Run::OutputDirectory directory;
-    directory.open(output.directory, description, options.resume, comm);
-    if (is_root())
-      Output::write_file(output_file("parameters.prm"), effective_parameters_);
-
-    try
-      {
-        method->run();
-      }
-    catch (const Interrupted &e)
-      {
-        directory.close("interrupted", e.what());
-        throw;
-      }
-    catch (const std::exception &e)
-      {
-        directory.close("failed", e.what());
-        throw;
-      }
-    wall.stop();
-
-    const std::string s = method->summary();
-    directory.close("finished", s);
-    pcout << "hysteron: '" << method_name_ << "' finished in " << wall.wall_time() << " s";
-    if (!s.empty())
-      pcout << " (" << s << ")";
-    pcout << ".\nResults are in " << output.directory << "/" << std::endl;
-    computing_timer->print_summary();
   }
 
   namespace Methods

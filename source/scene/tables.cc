@@ -117,7 +117,7 @@ namespace hysteron
 
     template <int dim>
     void
-    Tables<dim>::save(Run::CheckpointWriter &out) const
+    Tables<dim>::save(CheckpointWriter &out) const
     {
       out.section("tables");
       out.put(has_written);
@@ -129,7 +129,7 @@ namespace hysteron
 
     template <int dim>
     void
-    Tables<dim>::load(Run::CheckpointReader &in)
+    Tables<dim>::load(CheckpointReader &in)
     {
       in.section("tables");
       in.get(has_written);

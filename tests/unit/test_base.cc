@@ -13,6 +13,7 @@
 #include <hysteron/base/parameters.h>
 #include <hysteron/base/registry.h>
 #include <hysteron/material/interface.h>
+#include <hysteron/run/run_scene.h>
 #include <hysteron/scene/scene.h>
 
 #include <gtest/gtest.h>
@@ -317,7 +318,7 @@ TEST(Scene, RunsAMaterialPointSceneInProcess)
   Scene<3> scene(prm, options);
   EXPECT_EQ(scene.material_names(), (std::vector<std::string>{"", "soft"}));
   EXPECT_THROW(scene.material("hard", "Body/Material"), InputError);
-  scene.run();
+  Run::run_scene(scene);
 
   const std::string csv = read(d + "/history.csv");
   EXPECT_EQ(csv.substr(0, csv.find('\n')),

@@ -8,6 +8,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
 
 namespace hysteron
 {
@@ -66,6 +70,111 @@ namespace hysteron
     virtual void
     log(const unsigned int iteration, const double residual, const double alpha) = 0;
   };
+
+  /**
+   * The NewtonProblem of a method whose iterate is one vector u (the FEM's and the
+   * RBSN's displacements): the line search moves u = u_start + alpha du; the
+   * method supplies the evaluation, the correction and the log as callbacks
+   * (called once per iteration, not per DoF).
+   */
+  template <typename VectorType>
+  class VectorNewtonProblem : public NewtonProblem
+  {
+  public:
+    struct Callbacks
+    {
+      std::function<bool(bool)>                                 evaluate;
+      std::function<double()>                                   residual;
+      std::function<double()>                                   force_level;
+      /// Solve for @p du (with the constraints of the correction applied).
+      std::function<void(VectorType &du)>                       solve_correction;
+      std::function<void(unsigned int, double, double)>         log;
+    };
+
+    /// @p u: the iterate, @p du: where the correction is kept.
+    VectorNewtonProblem(VectorType &u, VectorType &du, Callbacks callbacks)
+      : u(u)
+      , du(du)
+      , start(u)
+      , callbacks(std::move(callbacks))
+    {}
+
+    bool
+    evaluate(const bool matrix) override
+    {
+      return callbacks.evaluate(matrix);
+    }
+
+    double
+    residual() const override
+    {
+      return callbacks.residual();
+    }
+
+    double
+    force_level() const override
+    {
+      return callbacks.force_level();
+    }
+
+    void
+    solve_correction() override
+    {
+      callbacks.solve_correction(du);
+    }
+
+    void
+    remember_start() override
+    {
+      start = u;
+    }
+
+    void
+    move(const double alpha) override
+    {
+      u = start;
+      u.add(alpha, du);
+    }
+
+    void
+    log(const unsigned int iteration, const double residual, const double alpha) override
+    {
+      callbacks.log(iteration, residual, alpha);
+    }
+
+  private:
+    VectorType &u, &du;
+    VectorType  start;
+    Callbacks   callbacks;
+  };
+
+  /// The round-off floor 64 eps sqrt(N) of a residual of @p n_dofs entries, relative to
+  /// the force level (a tighter tolerance would iterate on noise).
+  inline double
+  residual_floor(const double n_dofs)
+  {
+    return 64 * std::numeric_limits<double>::epsilon() * std::sqrt(n_dofs);
+  }
+
+  /// The columns of newton.csv (FEM and RBSN).
+  inline std::vector<std::string>
+  newton_columns()
+  {
+    return {"time", "step", "iteration", "residual", "force_level", "relative_residual", "line_search"};
+  }
+
+  /// A row of newton.csv: the iteration of the step of length @p dt to @p t1.
+  inline std::vector<double>
+  newton_row(const double       t1,
+             const double       dt,
+             const unsigned int iteration,
+             const double       residual,
+             const double       force_level,
+             const double       alpha)
+  {
+    return {t1, dt, double(iteration), residual, force_level,
+            force_level > 0 ? residual / force_level : 0.0, alpha};
+  }
 
   /**
    * Newton iterations from an evaluated iterate (with its matrix): converged

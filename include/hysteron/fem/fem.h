@@ -133,9 +133,9 @@ namespace hysteron
       void
       finish(double t) override;
       void
-      save(Run::CheckpointWriter &out) const override;
+      save(CheckpointWriter &out) const override;
       void
-      load(Run::CheckpointReader &in) override;
+      load(CheckpointReader &in) override;
 
     private:
       using Vector = dealii::TrilinosWrappers::MPI::Vector;
@@ -289,8 +289,7 @@ namespace hysteron
       double
       residual_floor() const
       {
-        return 64 * std::numeric_limits<double>::epsilon() *
-               std::sqrt(static_cast<double>(dof_handler.n_dofs()));
+        return hysteron::residual_floor(dof_handler.n_dofs());
       }
 
       /// A row of newton.csv.

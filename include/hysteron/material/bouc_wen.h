@@ -1,7 +1,7 @@
 #ifndef hysteron_material_bouc_wen_h
 #define hysteron_material_bouc_wen_h
 
-#include <hysteron/material/bouc_wen_kernels.h>
+#include <hysteron/material/bouc_wen_constants.h>
 #include <hysteron/material/bouc_wen_parameters.h>
 #include <hysteron/material/interface.h>
 
@@ -28,7 +28,7 @@ namespace hysteron
      *   alpha'   = (1 - m) C_p eps_p',   eps_ps' = |lambda'|,   e_h' = sigma : eps_p',
      *   eta' = c_eta eta^(-m_u) eps_ps',   nu_s = 1 + c_nu e_h / (sigma_y0 eps_y).
      * The stress rate is eq. 2.46: sigma' = (1/eta) D (I - nu_s H1 H2 R) eps'. See
-     * bouc_wen_kernels.h for the derivations, the integrators and the state layout.
+     * source/material/bouc_wen_kernels.h for the derivations, the integrators and the state layout.
      *
      * Stress states: 3D (full tensors), plane strain (the 3D law with eps_zz' = 0;
      * sigma_zz is carried in the state) and plane stress (reduced xx, yy, xy forms

@@ -11,7 +11,7 @@
 #include <hysteron/base/implicit_dynamics.h>
 #include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>
-#include <hysteron/run/checkpoint.h>
+#include <hysteron/base/checkpoint.h>
 #include <hysteron/material/bouc_wen_interaction.h>
 #include <hysteron/material/bouc_wen_uniaxial.h>
 #include <hysteron/rbsn/tessellation.h>
@@ -159,9 +159,9 @@ namespace hysteron
       std::string
       checkpoint_unsupported() const;
       void
-      save(Run::CheckpointWriter &out) const;
+      save(CheckpointWriter &out) const;
       void
-      load(Run::CheckpointReader &in);
+      load(CheckpointReader &in);
 
       /// The run's summary, with the driver's counts.
       std::string

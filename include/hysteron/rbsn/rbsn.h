@@ -75,9 +75,9 @@ namespace hysteron
       void
       finish(double t) override;
       void
-      save(Run::CheckpointWriter &out) const override;
+      save(CheckpointWriter &out) const override;
       void
-      load(Run::CheckpointReader &in) override;
+      load(CheckpointReader &in) override;
 
     private:
       std::unique_ptr<Model> model;

@@ -3,7 +3,7 @@
 
 #include <hysteron/base/exceptions.h>
 #include <hysteron/base/output.h>
-#include <hysteron/run/checkpoint.h>
+#include <hysteron/base/checkpoint.h>
 #include <hysteron/scene/method.h>
 
 #include <memory>

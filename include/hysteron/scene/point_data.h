@@ -36,7 +36,8 @@ namespace hysteron
     /// "x", "y", "z".
     extern const char *const component_names[3];
 
-    /// The columns of a point, without `time`.
+    /// The columns of a point, without `time`: the fixed ones, the state variables, then
+    /// the plugins selected in `Output/Additional columns` (output_column.h).
     template <int dim>
     std::vector<std::string>
     columns(const std::vector<std::string> &state_names);
@@ -50,7 +51,8 @@ namespace hysteron
      * The values of a point in the order of columns(): position @p x,
      * displacement @p u, velocity @p v, stress, von Mises, strain and the first
      * @p n_state_columns state variables (missing ones are 0; a null @p material
-     * is a rigid point without stress state).
+     * is a rigid point without stress state), then the additional columns
+     * (output_column.h).
      */
     template <int dim>
     void

@@ -77,8 +77,8 @@ namespace hysteron
    * (MPM, FEM, RBSN), as named subsections like the materials
    * (see doc/architecture.md).
    *
-   * run() prepares the output directory, writes the effective parameters to
-   * `parameters.prm`, runs the method and prints the summary and timer table.
+   * Run::run_scene() (run/run_scene.h) runs it: set-up, output directory,
+   * the method, the summary and timer table.
    */
   template <int dim>
   class Scene
@@ -90,9 +90,6 @@ namespace hysteron
 
     /// Parse and validate everything, including the method's own parameters.
     Scene(dealii::ParameterHandler &prm, const RunOptions &options);
-
-    void
-    run();
 
     /// The material called @p name; "" is the default `subsection Material`.
     const Material::Interface<dim> &
@@ -150,6 +147,20 @@ namespace hysteron
     resume() const
     {
       return options.resume;
+    }
+
+    /// The method that runs the scene.
+    Methods::Interface<dim> &
+    get_method()
+    {
+      return *method;
+    }
+
+    /// How the executable was called.
+    const RunOptions &
+    run_options() const
+    {
+      return options;
     }
 
     /// The registered name of the scene's method ("mpm").

@@ -5,7 +5,7 @@
 #include <deal.II/base/tensor.h>
 
 #include <hysteron/base/output.h>
-#include <hysteron/run/checkpoint.h>
+#include <hysteron/base/checkpoint.h>
 #include <hysteron/scene/point_data.h>
 
 #include <array>
@@ -66,9 +66,9 @@ namespace hysteron
 
       /// The state between rows (the last row's time, the energy reference).
       void
-      save(Run::CheckpointWriter &out) const;
+      save(CheckpointWriter &out) const;
       void
-      load(Run::CheckpointReader &in);
+      load(CheckpointReader &in);
 
     private:
       std::vector<std::unique_ptr<Output::TimeTable>> probe_tables, average_tables;

@@ -1,5 +1,5 @@
-#ifndef hysteron_scene_application_h
-#define hysteron_scene_application_h
+#ifndef hysteron_run_application_h
+#define hysteron_run_application_h
 
 namespace hysteron
 {

@@ -7,7 +7,8 @@
 #include <hysteron/base/exceptions.h>
 #include <hysteron/base/parameter_documentation.h>
 #include <hysteron/base/parameters.h>
-#include <hysteron/scene/application.h>
+#include <hysteron/run/application.h>
+#include <hysteron/run/run_scene.h>
 #include <hysteron/scene/scene.h>
 
 #include <dlfcn.h>
@@ -118,7 +119,7 @@ namespace hysteron
       auto scene = std::make_unique<Scene<dim>>(prm, options);
       try
         {
-          scene->run();
+          Run::run_scene(*scene);
         }
       catch (...)
         {

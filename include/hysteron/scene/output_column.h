@@ -1,0 +1,101 @@
+#ifndef hysteron_scene_output_column_h
+#define hysteron_scene_output_column_h
+
+#include <deal.II/base/array_view.h>
+#include <deal.II/base/point.h>
+#include <deal.II/base/symmetric_tensor.h>
+#include <deal.II/base/tensor.h>
+
+#include <hysteron/base/registry.h>
+#include <hysteron/material/interface.h>
+
+#include <string>
+#include <vector>
+
+namespace hysteron
+{
+  namespace PointData
+  {
+    /**
+     * What a point of a continuum method (an MPM material point, an FEM
+     * quadrature point) offers an output column: its position, displacement,
+     * velocity, stress and strain (tensor shear components), its material (null
+     * for a rigid point) and the material's state variables, and in 2D the
+     * out-of-plane stress sigma_zz (0 in plane stress).
+     */
+    template <int dim>
+    struct PointView
+    {
+      const dealii::Point<dim>              &x;
+      const dealii::Tensor<1, dim>          &u;
+      const dealii::Tensor<1, dim>          &v;
+      const dealii::SymmetricTensor<2, dim> &stress;
+      const dealii::SymmetricTensor<2, dim> &strain;
+      const Material::Interface<dim>        *material;
+      dealii::ArrayView<const double>        state;
+      double                                 sigma_zz;
+    };
+
+    /**
+     * An output column plugin: one or more columns computed from a point, appended
+     * to every point table of the MPM and the FEM (probe_<i>.csv, average_<i>.csv,
+     * particles.csv, quadrature_points.csv) when named in `Output/Additional
+     * columns`. Adding one takes one class and one registration line:
+     *
+     *   template <int dim>
+     *   class Pressure : public PointData::Column<dim>
+     *   {
+     *     std::vector<std::string> names() const override { return {"pressure"}; }
+     *     void evaluate(const PointData::PointView<dim> &p, double *out) const override
+     *     { out[0] = -(trace(p.stress) + p.sigma_zz) / 3; }
+     *   };
+     *   HYSTERON_REGISTER_OUTPUT_COLUMN(Pressure, "pressure", "p = -tr(sigma)/3 [Pa]")
+     *
+     * evaluate() runs once per point and row: no allocation there.
+     */
+    template <int dim>
+    class Column
+    {
+    public:
+      virtual ~Column() = default;
+
+      /// Parameters in `subsection Output` (optional; names must not clash).
+      static void
+      declare_parameters(dealii::ParameterHandler &)
+      {}
+
+      /// The names of the columns (e.g. {"pressure"}).
+      virtual std::vector<std::string>
+      names() const = 0;
+
+      /// Write names().size() values of point @p p into @p out.
+      virtual void
+      evaluate(const PointView<dim> &p, double *out) const = 0;
+    };
+
+    template <int dim>
+    using ColumnRegistry = Plugins::Registry<Column<dim>>;
+
+    /// The columns a scene asked for (`Output/Additional columns`), in the order given.
+    template <int dim>
+    const std::vector<std::unique_ptr<Column<dim>>> &
+    additional_columns();
+
+    /// Write the values of every additional column of @p point into @p out.
+    template <int dim>
+    void
+    evaluate_additional_columns(const PointView<dim> &point, double *out);
+
+    /// Select the additional columns by name (the Scene does this when it reads the
+    /// parameters; @p where is the parameter path for errors).
+    template <int dim>
+    void
+    select_additional_columns(const std::vector<std::string> &names, const std::string &where);
+  } // namespace PointData
+} // namespace hysteron
+
+/// Register the output column class template @p classname (dim = 2, 3) under @p name.
+#define HYSTERON_REGISTER_OUTPUT_COLUMN(classname, name, description) \
+  HYSTERON_REGISTER_DIM_PLUGIN(::hysteron::PointData::Column, classname, name, description)
+
+#endif

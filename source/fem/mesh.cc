@@ -1,0 +1,283 @@
+// The FEM mesh of the scene's bodies, the DoFs and vectors, and the quadrature-point history.
+#include <deal.II/base/utilities.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/grid/grid_in.h>
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/solver_cg.h>
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/solver_gmres.h>
+#include <deal.II/lac/sparsity_tools.h>
+#include <deal.II/lac/trilinos_precondition.h>
+#include <deal.II/lac/trilinos_solver.h>
+
+#include <hysteron/base/newton.h>
+#include <hysteron/base/parameters.h>
+#include <hysteron/fem/fem.h>
+#include <hysteron/geometry/mesh.h>
+
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+namespace hysteron
+{
+  namespace FEM
+  {
+    template <int dim>
+    void
+    Solver<dim>::make_mesh()
+    {
+      const Scene<dim> &scene  = this->get_scene();
+      const auto       &bodies = scene.body_descriptions();
+      body_to_mesh.assign(bodies.size(), dealii::numbers::invalid_unsigned_int);
+      mesh_to_body.clear();
+      std::vector<const Geometry::Region<dim> *> shapes;
+      for (unsigned int b = 0; b < bodies.size(); ++b)
+        if (!bodies[b].rigid)
+          {
+            body_to_mesh[b] = mesh_to_body.size();
+            mesh_to_body.push_back(b);
+            shapes.push_back(&bodies[b].shape);
+          }
+
+      if (generator == "file")
+        {
+          dealii::Triangulation<dim> serial;
+          dealii::GridIn<dim>        in;
+          in.attach_triangulation(serial);
+          try
+            {
+              in.read_msh(mesh_file);
+            }
+          catch (const dealii::ExceptionBase &e)
+            {
+              std::ostringstream m;
+              e.print_info(m);
+              throw InputError("FEM/Mesh/Mesh file", "cannot read '" + mesh_file + "': " + m.str());
+            }
+          for (const auto &cell : serial.active_cell_iterators())
+            {
+              require(cell->reference_cell() == dealii::ReferenceCells::get_hypercube<dim>(),
+                      "FEM/Mesh/Mesh file",
+                      "'" + mesh_file + "' has " + cell->reference_cell().to_string() +
+                        " cells; the fem method needs quadrilaterals (2D) or hexahedra (3D) "
+                        "(in Gmsh: Mesh.RecombineAll = 1 and Mesh.SubdivisionAlgorithm = 1)");
+              const auto   centre = cell->center();
+              unsigned int body   = dealii::numbers::invalid_unsigned_int;
+              for (unsigned int m = 0; m < shapes.size() && body == dealii::numbers::invalid_unsigned_int; ++m)
+                if (shapes[m]->contains(centre, 1e-9 * cell->diameter()))
+                  body = m;
+              if (body == dealii::numbers::invalid_unsigned_int)
+                {
+                  std::ostringstream p;
+                  p << centre;
+                  throw InputError("FEM/Mesh/Mesh file",
+                                   "the cell with centre (" + p.str() + ") of '" + mesh_file +
+                                     "' lies in no body's Shape");
+                }
+              cell->set_material_id(body);
+            }
+          triangulation.copy_triangulation(serial);
+        }
+      else
+        {
+          std::string kind = generator;
+          if (kind == "automatic")
+            {
+              bool rectilinear = true;
+              for (const auto *shape : shapes)
+                rectilinear = rectilinear && Geometry::is_rectilinear(*shape);
+              require(rectilinear || dim == 2,
+                      "FEM/Mesh/Generator",
+                      "in 3D only bodies made of boxes are meshed automatically; give a Gmsh "
+                      "file (Generator = file)");
+              kind = rectilinear ? "structured" : "unstructured";
+            }
+          Geometry::CoarseMesh<dim> mesh;
+          if constexpr (dim == 2)
+            mesh = kind == "structured" ?
+                     Geometry::structured_mesh<dim>(shapes, cell_size, "FEM/Mesh/Cell size") :
+                     // The generator's size bound is that of its triangles; each is split
+                     // into three quadrilaterals with edges of at most half of it.
+                     Geometry::unstructured_mesh(shapes, 2 * cell_size, "FEM/Mesh/Cell size",
+                                                 boundary_resolution > 0 ? boundary_resolution :
+                                                                           0.5 * cell_size);
+          else
+            mesh = Geometry::structured_mesh<dim>(shapes, cell_size, "FEM/Mesh/Cell size");
+          if (kind == "structured")
+            {
+              // A staircase approximation of a curved or oblique body is refused.
+              double body_volume = 0;
+              for (const auto *shape : shapes)
+                body_volume += shape->volume_estimate();
+              const double mismatch = std::abs(mesh.volume() - body_volume) / body_volume;
+              require(mismatch < 2e-3,
+                      "FEM/Mesh/Generator",
+                      "the structured mesh misses " + std::to_string(100 * mismatch) +
+                        " % of the bodies' volume (a body is not made of rectangles/boxes): "
+                        "use Generator = unstructured (2D) or a Gmsh file");
+            }
+          triangulation.create_triangulation(mesh.vertices, mesh.cells, dealii::SubCellData());
+        }
+      if (refinements > 0)
+        triangulation.refine_global(refinements);
+
+      // The bounding box of the mesh (faces of boundary conditions) and its scale.
+      std::vector<dealii::Point<dim>> corners;
+      for (const auto &cell : triangulation.active_cell_iterators())
+        if (cell->is_locally_owned())
+          for (const unsigned int v : cell->vertex_indices())
+            corners.push_back(cell->vertex(v));
+      dealii::Point<dim> lo, hi;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          lo[d] = std::numeric_limits<double>::max();
+          hi[d] = -std::numeric_limits<double>::max();
+        }
+      for (const auto &p : corners)
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            lo[d] = std::min(lo[d], p[d]);
+            hi[d] = std::max(hi[d], p[d]);
+          }
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          lo[d] = dealii::Utilities::MPI::min(lo[d], scene.mpi_communicator());
+          hi[d] = dealii::Utilities::MPI::max(hi[d], scene.mpi_communicator());
+        }
+      mesh_box = dealii::BoundingBox<dim>(std::make_pair(lo, hi));
+      u_scale  = 0;
+      for (unsigned int d = 0; d < dim; ++d)
+        u_scale = std::max(u_scale, hi[d] - lo[d]);
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::setup_system()
+    {
+      using namespace dealii;
+      const Scene<dim> &scene = this->get_scene();
+      MPI_Comm          comm  = scene.mpi_communicator();
+      fe              = std::make_unique<FESystem<dim>>(FE_Q<dim>(degree), dim);
+      quadrature      = std::make_unique<QGauss<dim>>(degree + 1);
+      face_quadrature = std::make_unique<QGauss<dim - 1>>(degree + 1);
+      dof_handler.reinit(triangulation);
+      dof_handler.distribute_dofs(*fe);
+      owned_dofs = dof_handler.locally_owned_dofs();
+      DoFTools::extract_locally_relevant_dofs(dof_handler, relevant_dofs);
+
+      u.reinit(owned_dofs, comm);
+      for (Vector *w : {&v, &a, &u_trial, &f_int, &f_ext, &f_int_old, &f_ext_old, &inertia})
+        w->reinit(owned_dofs, comm);
+      u_ghost.reinit(owned_dofs, relevant_dofs, comm);
+      v_ghost.reinit(owned_dofs, relevant_dofs, comm);
+      a_ghost.reinit(owned_dofs, relevant_dofs, comm);
+
+      // Materials of the mesh's bodies; the tangent kinds decide the solver.
+      const auto &bodies = scene.body_descriptions();
+      body_material.assign(mesh_to_body.size(), nullptr);
+      state_names.clear();
+      symmetric_tangent = consistent_tangent = true;
+      unsigned int n_state = 0;
+      for (unsigned int m = 0; m < mesh_to_body.size(); ++m)
+        {
+          const auto &body = bodies[mesh_to_body[m]];
+          body_material[m] = &scene.material(body.material, "Body " + body.name + "/Material");
+          if (body_material[m]->n_state_variables() > n_state)
+            {
+              n_state     = body_material[m]->n_state_variables();
+              state_names = body_material[m]->state_variable_names();
+            }
+          consistent_tangent = consistent_tangent && body_material[m]->has_consistent_tangent();
+          // Hooke's law and the continuum Bouc-Wen tangents are symmetric; the
+          // algorithmic tangents of a general local Newton need not be.
+          symmetric_tangent = symmetric_tangent && (body_material[m]->n_state_variables() == 0 ||
+                                                    !body_material[m]->has_consistent_tangent());
+        }
+
+      const unsigned long n_dofs = dof_handler.n_dofs();
+      LinearSolver        chosen = solver_type;
+      if (chosen == LinearSolver::automatic)
+        chosen = n_dofs <= direct_limit ? LinearSolver::direct :
+                 symmetric_tangent      ? LinearSolver::cg :
+                                          LinearSolver::gmres;
+      solver_type = chosen;
+      solver_name = chosen == LinearSolver::direct ? "direct (" + direct_package + ")" :
+                    chosen == LinearSolver::cg     ? "CG + AMG" :
+                                                     "GMRES + AMG";
+
+      if (analysis != Analysis::explicit_dynamics)
+        {
+          // The constrained DoFs are the same in every step (only their values
+          // change), so one sparsity pattern serves the whole run.
+          make_constraints(0.0, false);
+          DynamicSparsityPattern dsp(relevant_dofs);
+          DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
+          SparsityTools::distribute_sparsity_pattern(dsp, owned_dofs, comm, relevant_dofs);
+          system_matrix.reinit(owned_dofs, owned_dofs, dsp, comm);
+          system_rhs.reinit(owned_dofs, comm);
+        }
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::setup_history()
+    {
+      const auto &bodies = this->get_scene().body_descriptions();
+      const unsigned int n_q = quadrature->size();
+      dealii::FEValues<dim> fv(mapping, *fe, *quadrature,
+                               dealii::update_quadrature_points | dealii::update_JxW_values);
+      history.initialize(triangulation.begin_active(), triangulation.end(), 1);
+      // Raw pointers by active cell index: get_data() returns a vector of shared
+      // pointers (an allocation per call), too slow for the assembly loops.
+      cell_history.assign(triangulation.n_active_cells(), nullptr);
+      for (const auto &cell : triangulation.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            cell_history[cell->active_cell_index()] = history.get_data(cell)[0].get();
+            auto &h     = *cell_history[cell->active_cell_index()];
+            const unsigned int m = cell->material_id();
+            h.material  = body_material[m];
+            h.body      = mesh_to_body[m];
+            h.thickness = dim == 2 ? bodies[h.body].thickness : 1.0;
+            h.n_state   = h.material->n_state_variables();
+            h.stress.assign(n_q, dealii::SymmetricTensor<2, dim>());
+            h.strain        = h.stress;
+            h.trial_stress  = h.stress;
+            h.increment     = h.stress;
+            h.state.resize(n_q * h.n_state);
+            for (unsigned int q = 0; q < n_q; ++q)
+              h.material->initialize_state(
+                dealii::ArrayView<double>(h.state.data() + q * h.n_state, h.n_state));
+            h.trial_state = h.state;
+            h.weight.resize(n_q);
+            h.point.resize(n_q);
+            fv.reinit(cell);
+            for (unsigned int q = 0; q < n_q; ++q)
+              {
+                h.weight[q] = fv.JxW(q) * h.thickness;
+                h.point[q]  = fv.quadrature_point(q);
+              }
+            // Until a first evaluation: the elastic tangent (the first predictor).
+            h.tangent.assign(n_q, h.material->elasticity().template stiffness<dim>());
+          }
+    }
+
+
+
+    template void Solver<2>::make_mesh();
+    template void Solver<3>::make_mesh();
+    template void Solver<2>::setup_system();
+    template void Solver<3>::setup_system();
+    template void Solver<2>::setup_history();
+    template void Solver<3>::setup_history();
+  } // namespace FEM
+} // namespace hysteron

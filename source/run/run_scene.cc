@@ -1,0 +1,89 @@
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/timer.h>
+
+#include <hysteron/base/config.h>
+#include <hysteron/base/exceptions.h>
+#include <hysteron/base/output.h>
+#include <hysteron/run/run_scene.h>
+
+#include "run/checkpoint_files.h"
+#include "run/output_directory.h"
+
+namespace hysteron
+{
+  namespace Run
+  {
+    template <int dim>
+    void
+    run_scene(Scene<dim> &scene)
+    {
+      const MPI_Comm     comm    = scene.mpi_communicator();
+      const RunOptions  &options = scene.run_options();
+      const std::string &name    = scene.method_name();
+      const std::string &directory_name = scene.output_control().directory;
+      auto              &method  = scene.get_method();
+
+      // A directory that another run is writing is refused before any work.
+      OutputDirectory::check_not_in_use(directory_name, comm);
+      if (scene.checkpoint_control().enabled() || options.resume)
+        {
+          const std::string why = method.checkpoint_unsupported();
+          require(why.empty(),
+                  options.resume ? "--resume" : "Checkpoint",
+                  "method '" + name + "': " + why);
+        }
+      if (options.resume)
+        // A missing or foreign checkpoint is refused before the set-up.
+        open_resume(method.output_directory(), name, scene.effective_parameters(), comm);
+
+      dealii::Timer wall;
+      wall.start();
+      scene.console() << "hysteron " HYSTERON_VERSION ": " << dim << "D scene '"
+                      << options.parameter_file << "', method '" << name << "'" << std::endl;
+      {
+        dealii::TimerOutput::Scope timing(scene.timer(), "set-up");
+        method.setup();
+      }
+
+      // Only a scene that set up without a problem writes files.
+      RunDescription description;
+      description.command        = options.command_line;
+      description.parameter_file = options.parameter_file;
+      description.method         = name;
+      description.n_ranks        = dealii::Utilities::MPI::n_mpi_processes(comm);
+      OutputDirectory directory;
+      directory.open(directory_name, description, options.resume, comm);
+      if (scene.is_root())
+        Output::write_file(scene.output_file("parameters.prm"), scene.effective_parameters());
+
+      try
+        {
+          method.run();
+        }
+      catch (const Interrupted &e)
+        {
+          directory.close("interrupted", e.what());
+          throw;
+        }
+      catch (const std::exception &e)
+        {
+          directory.close("failed", e.what());
+          throw;
+        }
+      wall.stop();
+
+      const std::string summary = method.summary();
+      directory.close("finished", summary);
+      scene.console() << "hysteron: '" << name << "' finished in " << wall.wall_time() << " s";
+      if (!summary.empty())
+        scene.console() << " (" << summary << ")";
+      scene.console() << ".\nResults are in " << directory_name << "/" << std::endl;
+      scene.timer().print_summary();
+    }
+
+    template void
+    run_scene<2>(Scene<2> &);
+    template void
+    run_scene<3>(Scene<3> &);
+  } // namespace Run
+} // namespace hysteron
