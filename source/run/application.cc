@@ -11,6 +11,8 @@
 #include <hysteron/run/run_scene.h>
 #include <hysteron/scene/scene.h>
 
+#include "run/parameter_file.h"
+
 #include <dlfcn.h>
 #include <filesystem>
 #include <memory>
@@ -76,13 +78,28 @@ namespace hysteron
       SceneNames               names;
     };
 
+    /// Parse @p file into @p prm (deal.II's errors at the file and line they concern).
+    void
+    parse(dealii::ParameterHandler &prm, const Run::ParameterFile &file, const bool skip_undefined)
+    {
+      std::istringstream in(file.text);
+      try
+        {
+          prm.parse_input(in, file.name, "", skip_undefined);
+        }
+      catch (const dealii::ExceptionBase &e)
+        {
+          throw file.error(one_line(e));
+        }
+    }
+
     /// Read Dimension, Material names and libraries, skipping everything else.
     Preamble
-    read_preamble(const std::string &file)
+    read_preamble(const Run::ParameterFile &file)
     {
       dealii::ParameterHandler prm;
       declare_preamble(prm);
-      prm.parse_input(file, "", /*skip_undefined=*/true);
+      parse(prm, file, /*skip_undefined=*/true);
 
       Preamble p;
       p.dimension      = prm.get_integer("Dimension");
@@ -177,19 +194,14 @@ namespace hysteron
       if (files.size() > 1)
         throw InputError("command line", "more than one parameter file given (see hysteron --help)");
 
-      Preamble preamble;
+      Preamble          preamble;
+      Run::ParameterFile file;
       if (!files.empty())
         {
           options.parameter_file = files[0];
           check_readable(files[0]);
-          try
-            {
-              preamble = read_preamble(files[0]);
-            }
-          catch (const dealii::ExceptionBase &e)
-            {
-              throw InputError(files[0], one_line(e));
-            }
+          file     = Run::ParameterFile::read(files[0]);
+          preamble = read_preamble(file);
         }
       else if (!print_parameters)
         throw InputError("command line", "no parameter file given\n" + std::string(usage_text));
@@ -208,14 +220,7 @@ namespace hysteron
         Scene<3>::declare_parameters(prm, preamble.names);
 
       if (!files.empty())
-        try
-          {
-            prm.parse_input(files[0]);
-          }
-        catch (const dealii::ExceptionBase &e)
-          {
-            throw InputError(files[0], one_line(e));
-          }
+        parse(prm, file, /*skip_undefined=*/false);
 
       if (compare)
         prm.set("Method", "compare");
