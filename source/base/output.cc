@@ -32,9 +32,14 @@ namespace hysteron
       require(fs::is_directory(directory, ec),
               where,
               "'" + directory + "' exists and is not a directory");
-      require(::access(directory.c_str(), W_OK | X_OK) == 0,
-              where,
-              "the directory '" + directory + "' is not writable: " + std::strerror(errno));
+      // errno right after the call (an argument list's order of evaluation is unspecified).
+      if (::access(directory.c_str(), W_OK | X_OK) != 0)
+        {
+          const int error = errno;
+          throw InputError(where,
+                           "the directory '" + directory + "' is not writable: " +
+                             std::strerror(error));
+        }
     }
 
     AtomicFile::AtomicFile(const std::string &filename)

@@ -312,7 +312,6 @@ namespace hysteron
     {
       if (analysis == Analysis::explicit_dynamics && !step_checked)
         {
-          step_checked = true;
           const double nominal = increments.nominal();
           if (nominal > maximum_cfl * critical_step)
             {
@@ -324,6 +323,7 @@ namespace hysteron
                 << maximum_cfl * critical_step << " s or 0 (automatic).";
               throw Run::StepFailure(m.str());
             }
+          step_checked = true;
         }
       return increments.step(t, this->get_scene().time_control().end_time);
     }

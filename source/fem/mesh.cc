@@ -23,6 +23,7 @@
 #include <iomanip>
 #include <limits>
 #include <sstream>
+#include <unistd.h>
 namespace hysteron
 {
   namespace FEM
@@ -124,7 +125,28 @@ namespace hysteron
           triangulation.create_triangulation(mesh.vertices, mesh.cells, dealii::SubCellData());
         }
       if (refinements > 0)
-        triangulation.refine_global(refinements);
+        {
+          // Each refinement multiplies the cells by 2^dim: refuse a mesh that cannot fit in
+          // this machine's memory before making it (it would end in std::bad_alloc after
+          // minutes). About 2 kB per quadrature point (history, tangent, matrix rows).
+          const double cells = triangulation.n_global_active_cells() *
+                               std::pow(2.0, dim * static_cast<double>(refinements));
+          const double per_rank =
+            cells / dealii::Utilities::MPI::n_mpi_processes(this->get_scene().mpi_communicator());
+          const double bytes  = per_rank * std::pow(degree + 1.0, dim) * 2e3;
+          const double memory = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * sysconf(_SC_PAGE_SIZE);
+          if (bytes > memory)
+            {
+              std::ostringstream m;
+              m << "refining the mesh of " << triangulation.n_global_active_cells() << " cells "
+                << refinements << " times gives " << cells << " cells (" << per_rank
+                << " per MPI rank), about " << bytes / (1u << 30) << " GiB per rank with Q" << degree
+                << "; this machine has " << memory / (1u << 30)
+                << " GiB: use fewer refinements, a coarser FEM/Mesh/Cell size or more ranks";
+              throw InputError("FEM/Mesh/Refinements", m.str());
+            }
+          triangulation.refine_global(refinements);
+        }
 
       // The bounding box of the mesh (faces of boundary conditions) and its scale.
       std::vector<dealii::Point<dim>> corners;

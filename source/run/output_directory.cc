@@ -191,16 +191,34 @@ namespace hysteron
     } // namespace
 
     void
-    OutputDirectory::check_not_in_use(const std::string &directory, MPI_Comm comm)
+    OutputDirectory::check_usable(const std::string &directory, MPI_Comm comm)
     {
-      std::string holder;
+      std::string problem;
       if (dealii::Utilities::MPI::this_mpi_process(comm) == 0)
-        holder = lock_holder(directory);
-      holder = dealii::Utilities::MPI::broadcast(comm, holder, 0);
-      if (!holder.empty())
-        throw InputError("Output/Directory",
-                         "'" + directory + "' is in use by " + holder +
-                           "; wait for it to finish, stop it, or choose another directory");
+        {
+          // The directory, or the nearest existing folder it would be created in, must be
+          // a writable directory: found before the set-up, with nothing created.
+          std::error_code ec;
+          fs::path        existing = fs::absolute(directory, ec);
+          while (!existing.empty() && !fs::exists(existing, ec) && existing != existing.parent_path())
+            existing = existing.parent_path();
+          if (!fs::is_directory(existing, ec))
+            problem = "'" + existing.string() + "' is not a directory, so '" + directory +
+                      "' cannot be created";
+          else if (::access(existing.c_str(), W_OK | X_OK) != 0)
+            {
+              const int error = errno;
+              problem = "'" + existing.string() + "' is not writable (" + std::strerror(error) +
+                        "), so '" + directory + "' cannot be " +
+                        (existing == fs::absolute(directory, ec) ? "written" : "created");
+            }
+          else if (const std::string holder = lock_holder(directory); !holder.empty())
+            problem = "'" + directory + "' is in use by " + holder +
+                      "; wait for it to finish, stop it, or choose another directory";
+        }
+      problem = dealii::Utilities::MPI::broadcast(comm, problem, 0);
+      if (!problem.empty())
+        throw InputError("Output/Directory", problem);
     }
 
     void

@@ -32,9 +32,10 @@ namespace hysteron
     class OutputDirectory
     {
     public:
-      /// Before set-up: refuse a directory that a running process holds. Creates nothing.
+      /// Before set-up: refuse a directory that cannot be created or written, or that a
+      /// running process holds. Creates nothing.
       static void
-      check_not_in_use(const std::string &directory, MPI_Comm comm);
+      check_usable(const std::string &directory, MPI_Comm comm);
 
       /// After set-up: create, lock, clean (a new run) and start the manifest.
       void

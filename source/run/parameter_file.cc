@@ -179,11 +179,21 @@ namespace hysteron
     InputError
     ParameterFile::error(const std::string &message) const
     {
-      // deal.II: "Line <12> of file <scene.prm>: ..." (its count is of our expanded text).
-      static const std::regex line_of_file(R"(Line <(\d+)> of file <[^>]*>:?\s*)");
-      std::smatch             m;
-      if (!std::regex_search(message, m, line_of_file))
-        return InputError(name, message);
+      // deal.II: "Line <12> of file <scene.prm>: ..." (its count is of our expanded text;
+      // one message lacks the closing '>').
+      static const std::regex line_of_file(R"(Line <(\d+)> of file <[^>:]*>?:?\s*)");
+      // A named subsection (Body, Boundary, Load, Material) whose name is not declared.
+      static const std::regex undeclared(
+        R"(no such subsection to be entered: (Body|Boundary|Load|Material) (.+)$)");
+      std::string problem = message;
+      std::smatch named;
+      if (std::regex_search(message, named, undeclared))
+        problem += " (a `subsection " + named[1].str() + " " + named[2].str() +
+                   "` needs its name in the list: set " + named[1].str() + " names = " +
+                   named[2].str() + ")";
+      std::smatch m;
+      if (!std::regex_search(problem, m, line_of_file))
+        return InputError(name, problem);
       const unsigned long n = std::stoul(m[1].str());
       const std::string   place =
         n >= 1 && n <= origin.size() ? where(origin[n - 1].first, origin[n - 1].second) : name;

@@ -23,8 +23,9 @@ namespace hysteron
       const std::string &directory_name = scene.output_control().directory;
       auto              &method  = scene.get_method();
 
-      // A directory that another run is writing is refused before any work.
-      OutputDirectory::check_not_in_use(directory_name, comm);
+      // A directory that cannot be written, or that another run is writing, is refused
+      // before any work.
+      OutputDirectory::check_usable(directory_name, comm);
       if (scene.checkpoint_control().enabled() || options.resume)
         {
           const std::string why = method.checkpoint_unsupported();
@@ -44,6 +45,8 @@ namespace hysteron
         dealii::TimerOutput::Scope timing(scene.timer(), "set-up");
         method.setup();
       }
+      if (const std::string problem = method.check_size(); !problem.empty())
+        throw InputError("Time", problem);
 
       // Only a scene that set up without a problem writes files.
       RunDescription description;

@@ -11,6 +11,7 @@
 #include "run/checkpoint_files.h"
 #include "run/signals.h"
 
+#include <cmath>
 #include <csignal>
 #include <fstream>
 #include <iomanip>
@@ -59,6 +60,37 @@ namespace hysteron
 
     template <int dim>
     SteppingMethod<dim>::~SteppingMethod() = default;
+
+    template <int dim>
+    std::string
+    SteppingMethod<dim>::check_size()
+    {
+      const double end = this->get_scene().time_control().end_time;
+      double       dt  = 0;
+      try
+        {
+          dt = propose_step(0);
+        }
+      catch (const StepFailure &)
+        {
+          return ""; // the first step reports it, with the last good state
+        }
+      if (!(dt > 0))
+        return "";
+      const double       steps = std::ceil(end / dt);
+      const double       size  = size_of_state();
+      std::ostringstream m;
+      m.precision(3);
+      if (steps > 1e9)
+        m << label() << ": Time/End time = " << end << " s at a first step of " << dt << " s is "
+          << steps << " steps (more than 1e9): the run would not end. Shorten the End time or "
+          << "enlarge the step (Time/Time step, CFL factor, the number of increments).";
+      else if (size > 0 && steps * size > 1e14)
+        m << label() << ": " << steps << " steps of " << size << " unknowns (points or DoFs) are "
+          << steps * size << " unknown-steps, months of computing at ~1e7 per second and core: "
+          << "shorten Time/End time, enlarge the step or coarsen the discretisation.";
+      return m.str();
+    }
 
     template <int dim>
     void

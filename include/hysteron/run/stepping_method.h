@@ -55,6 +55,11 @@ namespace hysteron
       SteppingMethod();
       ~SteppingMethod() override;
 
+      /// The predicted number of steps (End time / the first step) and the work
+      /// (steps x size_of_state()) against fixed limits: 1e9 steps, 1e14 unknown-steps.
+      std::string
+      check_size() override;
+
       /// The driver: the same loop for every method.
       void
       run() final;
@@ -106,6 +111,13 @@ namespace hysteron
       virtual void
       finish(double)
       {}
+
+      /// The unknowns one step updates (material points, DoFs), for check_size(); 0: unknown.
+      virtual double
+      size_of_state() const
+      {
+        return 0;
+      }
 
       /// "" if this run can be checkpointed, else why not (refused at set-up).
       virtual std::string

@@ -48,6 +48,17 @@ namespace hysteron
       setup()
       {}
 
+      /**
+       * After setup(): "" if the run's predicted size is reasonable, else why not,
+       * with the estimate (a run of 1e30 steps is refused before it writes anything
+       * instead of running forever).
+       */
+      virtual std::string
+      check_size()
+      {
+        return "";
+      }
+
       /// "" if the method writes checkpoints (and can resume) in this scene, else why not.
       virtual std::string
       checkpoint_unsupported() const
