@@ -4,7 +4,7 @@
 A module is a folder source/<m>/ with its public headers include/hysteron/<m>/ (if any).
 An include of <hysteron/<x>/...> or "<x>/..." (a source-private header) from a file of module
 m is an edge m -> x. Prints a Markdown section: the modules in layers (a module only uses
-modules of lower layers), with their lines of code, public headers and dependencies, and any
+modules of lower layers), with their public headers and dependencies, and any
 cycle. With --check FILE, compares that section with the one between the markers in FILE and
 exits 1 if they differ (a ctest keeps doc/architecture.md current).
 
@@ -70,10 +70,10 @@ def layers(info):
 def section():
     info = graph()
     level, cycles = layers(info)
-    out = [BEGIN, "", "| layer | module | lines | public headers | uses |", "|---|---|---|---|---|"]
+    out = [BEGIN, "", "| layer | module | public headers | uses |", "|---|---|---|---|"]
     for m in sorted(info, key=lambda x: (-level[x], x)):
         deps = ", ".join(f"`{d}`" for d in sorted(info[m]["deps"], key=lambda x: (-level[x], x)))
-        out.append(f"| {level[m]} | `{m}/` | {info[m]['lines']} | {info[m]['headers']} | {deps or '(deal.II only)'} |")
+        out.append(f"| {level[m]} | `{m}/` | {info[m]['headers']} | {deps or '(deal.II only)'} |")
     out.append("")
     if cycles:
         out.append("Cycles (a module that uses a module which uses it): " +
