@@ -1,0 +1,155 @@
+// Boundary conditions and rigid bodies on the grid: the nodes of each condition, and the
+// nodal velocities they set (with the reactions and the boundary work).
+#include <deal.II/base/mpi.h>
+
+#include <hysteron/mpm/mpm.h>
+
+#include <algorithm>
+
+namespace hysteron
+{
+  namespace MPM
+  {
+    template <int dim>
+    void
+    Solver<dim>::setup_boundaries()
+    {
+      using Type              = typename BoundaryDescription<dim>::Type;
+      const Scene<dim> &scene = this->get_scene();
+      const auto       &lattice = grid->lattice();
+      boundaries.clear();
+      for (const auto &description : scene.boundary_descriptions())
+        {
+          BoundaryNodes b;
+          b.name       = description.name;
+          b.type       = static_cast<unsigned int>(description.type);
+          b.components = description.components;
+          for (unsigned int n = 0; n < grid->n_local_nodes(); ++n)
+            {
+              if (!grid->is_relevant(n))
+                continue;
+              const auto i = grid->lattice_index(n);
+              for (const unsigned int face : description.faces)
+                {
+                  const unsigned int d = face / 2;
+                  if (i[d] == (face % 2 == 0 ? 0 : static_cast<int>(lattice.n_cells[d])))
+                    {
+                      b.nodes.push_back(n);
+                      b.normal_direction.push_back(d);
+                      b.normal_sign.push_back(face % 2 == 0 ? 1 : -1);
+                    }
+                }
+              if (description.has_region &&
+                  description.region.contains(grid->node_position(n), 1e-9 * lattice.h))
+                {
+                  b.nodes.push_back(n);
+                  b.normal_direction.push_back(0);
+                  b.normal_sign.push_back(0);
+                }
+            }
+          const unsigned long n_nodes = dealii::Utilities::MPI::sum<unsigned long>(
+            std::count_if(b.nodes.begin(), b.nodes.end(), [&](const unsigned int n) { return grid->is_owned(n); }),
+            grid->mpi_communicator());
+          require(n_nodes > 0 || description.type != Type::fixed || !description.has_region,
+                  "Boundary " + description.name + "/Region",
+                  "the region contains no grid node");
+          boundaries.push_back(std::move(b));
+        }
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::apply_boundary_conditions(const double t, const double dt, const bool record)
+    {
+      using Type             = typename BoundaryDescription<dim>::Type;
+      constexpr unsigned int C = 1 + 2 * dim;
+      double *const          node = grid->data().data();
+      const auto            &scene_boundaries = this->get_scene().boundary_descriptions();
+
+      // Set component c of node r to `target`: the velocity change joins the
+      // FLIP increment, and m * change / dt is the reaction force on the body.
+      const auto impose = [&](double *r, const unsigned int c, const double target, const unsigned int n,
+                              dealii::Tensor<1, dim> &reaction) {
+        const double change = target - r[1 + c];
+        r[1 + c]            = target;
+        if (record)
+          {
+            r[1 + dim + c] += change;
+            if (grid->is_owned(n))
+              {
+                reaction[c] += r[0] * change / dt;
+                boundary_work += r[0] * change * target;
+              }
+          }
+      };
+
+      for (unsigned int b = 0; b < boundaries.size(); ++b)
+        {
+          const auto            &bc   = boundaries[b];
+          const Type             type = static_cast<Type>(bc.type);
+          dealii::Tensor<1, dim> prescribed;
+          if (type == Type::velocity)
+            prescribed = scene_boundaries[b].step_velocity(t, dt, dealii::Point<dim>());
+          for (unsigned int k = 0; k < bc.nodes.size(); ++k)
+            {
+              const unsigned int n = bc.nodes[k];
+              double *const      r = node + std::size_t(n) * C;
+              if (!(r[0] > small_mass))
+                continue;
+              const unsigned int d = bc.normal_direction[k];
+              switch (type)
+                {
+                  case Type::fixed:
+                    for (unsigned int c = 0; c < dim; ++c)
+                      impose(r, c, 0.0, n, reactions[b]);
+                    break;
+                  case Type::displacement:
+                    // u may depend on the node's position: its mean velocity over the step.
+                    prescribed = scene_boundaries[b].step_velocity(t, dt, grid->node_position(n));
+                    [[fallthrough]];
+                  case Type::velocity:
+                    for (unsigned int c = 0; c < dim; ++c)
+                      if (bc.components[c])
+                        impose(r, c, prescribed[c], n, reactions[b]);
+                    break;
+                  case Type::roller:
+                    impose(r, d, 0.0, n, reactions[b]);
+                    break;
+                  case Type::wall:
+                    // Lower face (sign +1): the body may not move in -d; upper face: not in +d.
+                    impose(r, d, bc.normal_sign[k] > 0 ? std::max(r[1 + d], 0.0) : std::min(r[1 + d], 0.0), n, reactions[b]);
+                    break;
+                }
+            }
+        }
+
+      // Nodes touched by a rigid body move with it.
+      if (!rigid_nodes.empty())
+        {
+          const auto &bodies = this->get_scene().body_descriptions();
+          std::vector<dealii::Tensor<1, dim>> v(bodies.size());
+          for (unsigned int b = 0; b < bodies.size(); ++b)
+            if (bodies[b].rigid)
+              v[b] = evaluate_in_time<dim>(*bodies[b].rigid_velocity, t);
+          for (const unsigned int n : rigid_nodes)
+            {
+              double *const r = node + std::size_t(n) * C;
+              if (!(r[0] > small_mass))
+                continue;
+              const unsigned int b = rigid_node_body[n] - 1;
+              for (unsigned int c = 0; c < dim; ++c)
+                impose(r, c, v[b][c], n, reactions[boundaries.size() + b]);
+            }
+        }
+    }
+
+
+
+    template void Solver<2>::setup_boundaries();
+    template void Solver<3>::setup_boundaries();
+    template void Solver<2>::apply_boundary_conditions(double, double, bool);
+    template void Solver<3>::apply_boundary_conditions(double, double, bool);
+  } // namespace MPM
+} // namespace hysteron

@@ -1,0 +1,463 @@
+// The material points: the bodies filled with points (before the grid, whose partition
+// they weigh), the points' creation in the ParticleHandler, and the copies between the
+// handler and the step's contiguous arrays (from_handler(), to_handler()).
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
+
+#include <hysteron/mpm/mpm.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <numeric>
+
+namespace hysteron
+{
+  namespace MPM
+  {
+    namespace
+    {
+      const char *const *const component_suffix = PointData::component_names;
+    } // namespace
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::setup_grid()
+    {
+      const Scene<dim> &scene = this->get_scene();
+      // Fill the bodies first (every rank, same order): the points per cell
+      // weigh the cells when p4est partitions them, so that ranks get equal work.
+      Lattice<dim> lattice;
+      lattice.origin  = lower;
+      lattice.h       = cell_size;
+      lattice.n_cells = n_cells;
+      const Geometry::FillLattice<dim> fill_lattice{lower, cell_size, n_cells};
+      std::vector<unsigned int>        points_per_cell;
+      if (dealii::Utilities::MPI::n_mpi_processes(scene.mpi_communicator()) > 1)
+        points_per_cell.assign(std::accumulate(n_cells.begin(), n_cells.end(), 1u, std::multiplies<>()), 0);
+      body_points.clear();
+      for (const auto &body : scene.body_descriptions())
+        {
+          body_points.push_back(Geometry::fill(body.shape, fill_lattice, body.particles_per_cell));
+          if (!points_per_cell.empty())
+            for (const auto &x : body_points.back())
+              {
+                const auto         c  = lattice.cell_of(x);
+                unsigned int       id = 0;
+                for (int d = dim - 1; d >= 0; --d)
+                  id = id * n_cells[d] + c[d];
+                ++points_per_cell[id];
+              }
+        }
+      grid = std::make_unique<BackgroundGrid<dim>>(scene.mpi_communicator());
+      grid->initialize(lower, cell_size, n_cells, 1 + 2 * dim, points_per_cell);
+      node_stamp.assign(grid->n_local_nodes(), 0);
+      rigid_node_body.assign(grid->n_local_nodes(), 0);
+      active_nodes.clear();
+      rigid_nodes.clear();
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::generate_particles()
+    {
+      using namespace dealii;
+      using PI              = PropertiesIndex<dim>;
+      const Scene<dim> &scene = this->get_scene();
+      const auto       &bodies = scene.body_descriptions();
+      const auto       &loads  = scene.load_descriptions();
+
+      // Groups: one per material of the deformable bodies, one per rigid body.
+      group_of_body.assign(bodies.size(), 0);
+      group_templates.clear();
+      particles.n_state_slots = 0;
+      state_names.clear();
+      for (unsigned int b = 0; b < bodies.size(); ++b)
+        {
+          typename ParticleStore<dim>::Group g;
+          if (bodies[b].rigid)
+            g.rigid_body = b;
+          else
+            {
+              g.material   = &scene.material(bodies[b].material, "Body " + bodies[b].name + "/Material");
+              g.n_state    = g.material->n_state_variables();
+              g.wave_speed = g.material->elasticity().p_wave_speed();
+              if (g.n_state > particles.n_state_slots)
+                {
+                  particles.n_state_slots = g.n_state;
+                  state_names             = g.material->state_variable_names();
+                }
+            }
+          unsigned int found = group_templates.size();
+          for (unsigned int i = 0; i < group_templates.size(); ++i)
+            if (!bodies[b].rigid && group_templates[i].material == g.material)
+              found = i;
+          if (found == group_templates.size())
+            group_templates.push_back(g);
+          group_of_body[b] = found;
+        }
+
+      n_properties = PI::n_fixed + particles.n_state_slots;
+      handler      = std::make_unique<Particles::ParticleHandler<dim>>(grid->triangulation(),
+                                                                     mapping,
+                                                                     n_properties);
+
+      // Every rank generates all points in the same order (so the ids, load
+      // counts and probe points agree) and keeps those in its own cells.
+      const Lattice<dim> &lattice = grid->lattice();
+      load_count.assign(loads.size() + 1, 0);
+      std::vector<double>    properties(n_properties);
+      types::particle_index  next_id = 0;
+      std::vector<double>    best_distance(probes.size(), std::numeric_limits<double>::max());
+      for (unsigned int b = 0; b < bodies.size(); ++b)
+        {
+          const auto &body   = bodies[b];
+          const auto &points = body_points[b];
+          require(!points.empty(),
+                  "Body " + body.name + "/Shape",
+                  "the body holds no material point (points sit at the centres of the " +
+                    std::to_string(body.particles_per_cell) + "^" + std::to_string(dim) +
+                    " sub-cells of each grid cell: refine the grid or raise `Particles per "
+                    "cell`)");
+          const auto  &group     = group_templates[group_of_body[b]];
+          const double thickness = dim == 2 ? body.thickness : 1.0;
+          const double volume    = std::pow(lattice.h / body.particles_per_cell, dim) * thickness;
+          const double density =
+            scene.material(body.material, "Body " + body.name + "/Material").density();
+          for (const auto &x : points)
+            {
+              const types::particle_index id = next_id++;
+              unsigned int                load = 0;
+              if (!body.rigid)
+                for (unsigned int l = 0; l < loads.size() && load == 0; ++l)
+                  if (loads[l].region.contains(x, 1e-9 * lattice.h))
+                    load = l + 1;
+              ++load_count[load];
+              for (unsigned int i = 0; i < probes.size(); ++i)
+                if (!body.rigid)
+                  {
+                    const double distance = x.distance(probes[i].point);
+                    if (distance < best_distance[i])
+                      {
+                        best_distance[i]            = distance;
+                        probes[i].id                = id;
+                        probes[i].initial_position = x;
+                      }
+                  }
+
+              const auto         cell = lattice.cell_of(x);
+              const unsigned int cid  = grid->cell_id(cell);
+              if (!grid->owns_cell(cid))
+                continue;
+              std::fill(properties.begin(), properties.end(), 0.0);
+              properties[PI::mass]      = density * volume;
+              properties[PI::volume0]   = volume;
+              properties[PI::volume]    = volume;
+              properties[PI::thickness] = thickness;
+              properties[PI::body]      = b;
+              properties[PI::load]      = load;
+              const Tensor<1, dim> v =
+                body.rigid ? evaluate_in_time<dim>(*body.rigid_velocity, 0.0) : body.velocity_at(x);
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  properties[PI::velocity + d]                       = v[d];
+                  properties[PI::deformation_gradient + d * dim + d] = 1.0;
+                }
+              if (group.material != nullptr && group.n_state > 0)
+                group.material->initialize_state(
+                  view(properties.data() + PI::n_fixed, group.n_state));
+              Point<dim> reference;
+              for (unsigned int d = 0; d < dim; ++d)
+                reference[d] = (x[d] - lattice.origin[d]) / lattice.h - cell[d];
+              handler->insert_particle(x, reference, id, grid->cell_iterator(cid), make_array_view(properties));
+            }
+        }
+      n_global_particles = next_id;
+      body_points.clear();
+      body_points.shrink_to_fit();
+      handler->update_cached_numbers();
+      for (unsigned int l = 1; l < load_count.size(); ++l)
+        require(load_count[l] > 0,
+                "Load " + loads[l - 1].name + "/Region",
+                "the region contains no material point of a deformable body");
+      load_per_point.assign(loads.size() + 1, Tensor<1, dim>());
+      reactions.assign(scene.boundary_descriptions().size() + bodies.size(), Tensor<1, dim>());
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::from_handler()
+    {
+      using namespace dealii;
+      using PI                = PropertiesIndex<dim>;
+      const Scene<dim> &scene = this->get_scene();
+      const auto       &loads = scene.load_descriptions();
+      const unsigned int n    = handler->n_locally_owned_particles();
+      const Lattice<dim> &lattice = grid->lattice();
+
+      // First pass: the sort key of every point (handler order): group, cell, id.
+      std::vector<types::particle_index> ids(n);
+      std::vector<unsigned int>          key(n), cells(n);
+      {
+        unsigned int k = 0;
+        for (const auto &particle : *handler)
+          {
+            ids[k]   = particle.get_id();
+            key[k]   = group_of_body[static_cast<unsigned int>(particle.get_properties()[PI::body])];
+            cells[k] = grid->cell_id(lattice.cell_of(particle.get_location()));
+            ++k;
+          }
+      }
+      std::vector<unsigned int> order(n);
+      std::iota(order.begin(), order.end(), 0);
+      std::sort(order.begin(), order.end(), [&](const unsigned int a, const unsigned int b) {
+        return std::tie(key[a], cells[a], ids[a]) < std::tie(key[b], cells[b], ids[b]);
+      });
+
+      // Group ranges and state offsets.
+      particles.groups.clear();
+      std::size_t n_state_total = 0;
+      for (unsigned int s = 0; s < n; ++s)
+        {
+          const unsigned int g = key[order[s]];
+          if (particles.groups.empty() || g != current_group_key)
+            {
+              auto group         = group_templates[g];
+              group.begin        = s;
+              group.end          = s;
+              group.state_offset = n_state_total;
+              particles.groups.push_back(group);
+              current_group_key = g;
+            }
+          auto &group = particles.groups.back();
+          ++group.end;
+          n_state_total += group.n_state;
+        }
+
+      auto &P = particles;
+      P.id.resize(n);
+      P.body.resize(n);
+      P.load.resize(n);
+      P.mass.resize(n);
+      P.volume0.resize(n);
+      P.thickness.resize(n);
+      P.load_factor.resize(n);
+      P.x0.resize(n);
+      P.cell.resize(n);
+      P.handler_index.resize(n);
+      P.current.resize(n, n_state_total);
+      P.next.resize(n, n_state_total);
+
+      // Second pass (same order): copy every point straight to its place.
+      std::vector<unsigned int> place(n), group_of(n);
+      for (unsigned int s = 0; s < n; ++s)
+        place[order[s]] = s;
+      for (unsigned int g = 0; g < P.groups.size(); ++g)
+        for (unsigned int s = P.groups[g].begin; s < P.groups[g].end; ++s)
+          group_of[s] = g;
+      unsigned int k = 0;
+      for (const auto &particle : *handler)
+        {
+          const unsigned int s     = place[k];
+          const auto        &group = P.groups[group_of[s]];
+          const auto         q     = particle.get_properties();
+          const Point<dim>   x     = particle.get_location();
+          P.handler_index[s]       = k;
+          P.id[s]                  = ids[k];
+          P.cell[s]                = cells[k];
+          ++k;
+          P.body[s]           = static_cast<unsigned int>(q[PI::body]);
+          P.load[s]           = static_cast<unsigned int>(q[PI::load]);
+          P.mass[s]           = q[PI::mass];
+          P.volume0[s]        = q[PI::volume0];
+          P.thickness[s]      = q[PI::thickness];
+          P.current.x[s]      = x;
+          P.current.volume[s] = q[PI::volume];
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              P.current.v[s][d] = q[PI::velocity + d];
+              P.x0[s][d]        = x[d] - q[PI::displacement + d];
+              for (unsigned int e = 0; e < dim; ++e)
+                P.current.F[s][d][e] = q[PI::deformation_gradient + d * dim + e];
+            }
+          for (unsigned int c = 0; c < PI::n_sym; ++c)
+            {
+              const auto ij = SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
+              P.current.stress[s][ij] = q[PI::stress + c];
+              P.current.strain[s][ij] = q[PI::strain + c];
+            }
+          std::copy(q.begin() + PI::n_fixed,
+                    q.begin() + PI::n_fixed + group.n_state,
+                    P.current.material_state.begin() + group.state_offset +
+                      std::size_t(s - group.begin) * group.n_state);
+          // Load share: a total force is split evenly; a traction acts on the
+          // point's face, of area V / l_p with l_p = (V / thickness)^(1/dim).
+          P.load_factor[s] = 0;
+          if (P.load[s] > 0)
+            {
+              if (loads[P.load[s] - 1].type == LoadDescription<dim>::Type::force)
+                P.load_factor[s] = 1.0 / load_count[P.load[s]];
+              else
+                P.load_factor[s] = P.volume0[s] / std::pow(P.volume0[s] / P.thickness[s], 1.0 / dim);
+            }
+        }
+
+      for (auto &probe : probes)
+        probe.local = -1;
+      for (unsigned int s = 0; s < n; ++s)
+        for (auto &probe : probes)
+          if (P.id[s] == probe.id)
+            probe.local = s;
+      n_changed_cells = 0;
+      left_subdomain  = false;
+
+      // The speed that bounds the next step (eq. 4.47).
+      max_speed = 0;
+      for (const auto &group : P.groups)
+        for (unsigned int s = group.begin; s < group.end; ++s)
+          max_speed = std::max(max_speed, group.wave_speed + P.current.v[s].norm());
+    }
+
+
+
+    template <int dim>
+    void
+    ParticleStore<dim>::State::resize(const std::size_t n, const std::size_t n_material_state)
+    {
+      x.resize(n);
+      v.resize(n);
+      stress.resize(n);
+      strain.resize(n);
+      F.resize(n);
+      volume.resize(n);
+      material_state.resize(n_material_state);
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::to_handler()
+    {
+      using namespace dealii;
+      using PI = PropertiesIndex<dim>;
+      const auto        &P = particles;
+      const unsigned int n = P.size();
+      std::vector<unsigned int> store_index(n);
+      for (unsigned int s = 0; s < n; ++s)
+        store_index[P.handler_index[s]] = s;
+      std::vector<unsigned int> group_of(n);
+      for (unsigned int g = 0; g < P.groups.size(); ++g)
+        for (unsigned int s = P.groups[g].begin; s < P.groups[g].end; ++s)
+          group_of[s] = g;
+
+      unsigned int k = 0;
+      for (auto &particle : *handler)
+        {
+          const unsigned int s     = store_index[k++];
+          const auto        &group = P.groups[group_of[s]];
+          auto               q     = particle.get_properties();
+          const double      *state = P.current.material_state.data() + group.state_offset +
+                                std::size_t(s - group.begin) * group.n_state;
+          q[PI::volume] = P.current.volume[s];
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              q[PI::velocity + d]     = P.current.v[s][d];
+              q[PI::displacement + d] = P.current.x[s][d] - P.x0[s][d];
+              for (unsigned int e = 0; e < dim; ++e)
+                q[PI::deformation_gradient + d * dim + e] = P.current.F[s][d][e];
+            }
+          for (unsigned int c = 0; c < PI::n_sym; ++c)
+            {
+              const auto ij         = SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
+              q[PI::stress + c] = P.current.stress[s][ij];
+              q[PI::strain + c] = P.current.strain[s][ij];
+            }
+          // von Mises stress with the out-of-plane component in 2D.
+          double sigma_zz = 0;
+          if (dim == 2 && group.material != nullptr)
+            {
+              double eps_zz = 0;
+              group.material->out_of_plane(P.current.strain[s],
+                                           P.current.stress[s],
+                                           view(state, group.n_state),
+                                           eps_zz,
+                                           sigma_zz);
+            }
+          const SymmetricTensor<2, dim> &sigma = P.current.stress[s];
+          const double                   tr    = dealii::trace(sigma) + sigma_zz;
+          double dev2 = (sigma * sigma) + sigma_zz * sigma_zz - tr * tr / 3.0;
+          q[PI::von_mises] = std::sqrt(std::max(0.0, 1.5 * dev2));
+          std::fill(q.begin() + PI::n_fixed, q.end(), 0.0);
+          std::copy(state, state + group.n_state, q.begin() + PI::n_fixed);
+          particle.set_location(P.current.x[s]);
+        }
+    }
+
+
+
+    template <int dim>
+    std::vector<std::string>
+    PropertiesIndex<dim>::names(const std::vector<std::string> &state_names)
+    {
+      std::vector<std::string> n{"mass", "volume0", "volume", "thickness", "body", "load"};
+      for (unsigned int d = 0; d < dim; ++d)
+        n.emplace_back("velocity");
+      for (unsigned int d = 0; d < dim; ++d)
+        n.emplace_back("displacement");
+      for (unsigned int c = 0; c < n_sym; ++c)
+        {
+          const auto ij = dealii::SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
+          n.push_back(std::string("stress_") + component_suffix[ij[0]] + component_suffix[ij[1]]);
+        }
+      n.emplace_back("von_mises");
+      for (unsigned int c = 0; c < n_sym; ++c)
+        {
+          const auto ij = dealii::SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
+          n.push_back(std::string("strain_") + component_suffix[ij[0]] + component_suffix[ij[1]]);
+        }
+      for (unsigned int d = 0; d < dim; ++d)
+        for (unsigned int e = 0; e < dim; ++e)
+          n.push_back(std::string("F_") + component_suffix[d] + component_suffix[e]);
+      n.insert(n.end(), state_names.begin(), state_names.end());
+      return n;
+    }
+
+
+
+    template <int dim>
+    std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
+    PropertiesIndex<dim>::interpretations(const unsigned int n_state)
+    {
+      using namespace dealii::DataComponentInterpretation;
+      std::vector<DataComponentInterpretation> i(n_fixed + n_state, component_is_scalar);
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          i[velocity + d]     = component_is_part_of_vector;
+          i[displacement + d] = component_is_part_of_vector;
+        }
+      return i;
+    }
+
+
+
+    template void Solver<2>::setup_grid();
+    template void Solver<3>::setup_grid();
+    template void Solver<2>::generate_particles();
+    template void Solver<3>::generate_particles();
+    template void Solver<2>::from_handler();
+    template void Solver<3>::from_handler();
+    template void Solver<2>::to_handler();
+    template void Solver<3>::to_handler();
+    template struct PropertiesIndex<2>;
+    template struct PropertiesIndex<3>;
+    template struct ParticleStore<2>;
+    template struct ParticleStore<3>;
+  } // namespace MPM
+} // namespace hysteron
