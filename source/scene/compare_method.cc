@@ -54,6 +54,15 @@ namespace hysteron
           method->setup();
       }
 
+      std::string
+      check_size() override
+      {
+        for (auto &method : methods)
+          if (std::string problem = method->check_size(); !problem.empty())
+            return problem;
+        return "";
+      }
+
       void
       run() override
       {
