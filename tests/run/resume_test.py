@@ -25,6 +25,9 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from run_prm_test import compare_csv  # noqa: E402  (the 1-rank/2-rank comparison)
+
 
 def run(command, cwd, env, timeout=900):
     p = subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
@@ -58,21 +61,6 @@ def read_table(path):
             raise ValueError(f"{path}: row {i} has {len(r)} values for {len(header)} columns")
         values.append([float(x) for x in r])
     return header, values
-
-
-def compare(reference, other, tolerance):
-    h1, a = read_table(reference)
-    h2, b = read_table(other)
-    if h1 != h2:
-        return "the columns differ"
-    if len(a) != len(b):
-        return f"{len(b)} rows instead of {len(a)}"
-    for c, name in enumerate(h1):
-        scale = max([abs(r[c]) for r in a] + [1e-300])
-        for i, (x, y) in enumerate(zip(a, b)):
-            if abs(x[c] - y[c]) > tolerance * scale:
-                return f"column {name}, row {i}: {x[c]!r} vs {y[c]!r} (column scale {scale:g})"
-    return None
 
 
 def pvd_times(directory):
@@ -172,7 +160,7 @@ def main():
             failures.append(f"tables differ: {sorted(expected)} vs {sorted(got)}")
         for relative in sorted(expected):
             if relative in got:
-                problem = compare(expected[relative], got[relative], args.tolerance)
+                problem = compare_csv(expected[relative], got[relative], (args.tolerance, 0.0))
                 if problem:
                     failures.append(f"{relative}: {problem}")
         if pvd_times(reference) != pvd_times(stopped):
