@@ -1,19 +1,22 @@
-// Unit tests of the comparison of two runs' tables (base/compare.h): reading CSV files,
+// Unit tests of the comparison of two runs' tables (compare/compare.h): reading CSV files,
 // interpolation in time, the norms, the side-by-side, summary and plot outputs.
 #include <deal.II/base/numbers.h>
 
-#include <hysteron/base/compare.h>
 #include <hysteron/base/exceptions.h>
 #include <hysteron/base/output.h>
 
+#include "compare/compare.h"
+
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <sstream>
+#include <thread>
 
 namespace
 {
@@ -564,4 +567,166 @@ TEST(CompareGnuplot, AFailedPlotLeavesNeitherAPartialNorAStalePng)
   EXPECT_NE(warning.find("no_such_command"), std::string::npos) << warning;
   EXPECT_FALSE(fs::exists(d + "/p.png"));
   EXPECT_FALSE(fs::exists(d + "/p.png.tmp"));
+}
+
+// The plot runner (compare/plotter.cc): a plotter runs without a shell, within its timeout, and
+// leaves either a complete PNG or none.
+namespace
+{
+  /// An executable shell script @p name in @p directory: a fake plotter.
+  std::string
+  write_script(const std::string &directory, const std::string &name, const std::string &body)
+  {
+    const std::string file = directory + "/" + name;
+    Output::write_file(file, "#!/bin/sh\n" + body);
+    fs::permissions(file, fs::perms::owner_exec, fs::perm_options::add);
+    return fs::absolute(file).string();
+  }
+
+  /// The fake plotter @p script run in @p directory, drawing p.png, for at most @p timeout s.
+  Compare::PlotCommand
+  plot_command(const std::string &script, const std::string &directory, const double timeout = 10)
+  {
+    Compare::PlotCommand command;
+    command.arguments = {script, "p.gp"};
+    command.directory = directory;
+    command.png_file  = "p.png";
+    command.subject   = directory + "/p.gp";
+    command.timeout   = timeout;
+    return command;
+  }
+
+  double
+  seconds_since(const std::chrono::steady_clock::time_point start)
+  {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
+  /// PATH set to @p path for the lifetime of the object.
+  class ScopedPath
+  {
+  public:
+    explicit ScopedPath(const std::string &path)
+      : saved(std::getenv("PATH") == nullptr ? "" : std::getenv("PATH"))
+    {
+      ::setenv("PATH", path.c_str(), 1);
+    }
+
+    ~ScopedPath()
+    {
+      ::setenv("PATH", saved.c_str(), 1);
+    }
+
+  private:
+    const std::string saved;
+  };
+
+  /// Whether process @p pid is gone (or a zombie) within @p seconds.
+  bool
+  process_ends(const std::string &pid, const double seconds)
+  {
+    const auto start = std::chrono::steady_clock::now();
+    while (seconds_since(start) < seconds)
+      {
+        std::ifstream stat("/proc/" + pid + "/stat");
+        std::string   line;
+        if (!std::getline(stat, line) || line.substr(line.rfind(')') + 2, 1) == "Z")
+          return true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    return false;
+  }
+} // namespace
+
+TEST(CompareRunPlotter, APlotterThatSucceedsLeavesItsPngOnly)
+{
+  const std::string d = fresh_directory("plotter_success");
+  const std::string script =
+    write_script(d, "plotter", "[ \"$1\" = p.gp ] && echo png > p.png.tmp\n");
+  Output::write_file(d + "/p.png", "an earlier plot");
+  EXPECT_EQ(Compare::run_plotter(plot_command(script, d)), "");
+  EXPECT_EQ(read(d + "/p.png"), "png\n");
+  EXPECT_FALSE(has_temporary_files(d));
+
+  // What the plotter prints is a warning; the PNG stays.
+  const std::string talking =
+    write_script(d, "talking plotter", "echo png > p.png.tmp\necho 'warning: a b' >&2\n");
+  EXPECT_EQ(Compare::run_plotter(plot_command(talking, d)),
+            "talking plotter on " + d + "/p.gp: warning: a b");
+  EXPECT_TRUE(fs::exists(d + "/p.png"));
+}
+
+TEST(CompareRunPlotter, APlotterThatFailsLeavesNoPngAndAWarning)
+{
+  const std::string d = fresh_directory("plotter_failure");
+  const std::string script =
+    write_script(d, "plotter", "echo partial > p.png.tmp\necho 'cannot draw' >&2\nexit 3\n");
+  Output::write_file(d + "/p.png", "an earlier plot");
+  EXPECT_EQ(Compare::run_plotter(plot_command(script, d)),
+            "plotter failed on " + d + "/p.gp (exit status 3): cannot draw; no PNG written");
+  EXPECT_FALSE(fs::exists(d + "/p.png"));
+  EXPECT_FALSE(has_temporary_files(d));
+
+  const std::string idle = write_script(d, "idle", "exit 0\n");
+  EXPECT_EQ(Compare::run_plotter(plot_command(idle, d)),
+            "idle failed on " + d + "/p.gp (it drew no p.png.tmp); no PNG written");
+
+  EXPECT_EQ(Compare::run_plotter(plot_command(d + "/none", d)),
+            "cannot run none on " + d + "/p.gp: No such file or directory; no PNG written");
+  EXPECT_FALSE(fs::exists(d + "/p.png"));
+}
+
+TEST(CompareRunPlotter, APlotThatExceedsItsTimeoutIsKilledAndLeavesNoPng)
+{
+  const std::string d = fresh_directory("plotter_timeout");
+  // The plotter starts a child that holds the output pipe: both must go.
+  const std::string script =
+    write_script(d, "plotter", "echo partial > p.png.tmp\nsleep 30 &\necho $! > sleep.pid\nwait\n");
+  Output::write_file(d + "/p.png", "an earlier plot");
+  const auto        start   = std::chrono::steady_clock::now();
+  const std::string warning = Compare::run_plotter(plot_command(script, d, 0.5));
+  const double      elapsed = seconds_since(start);
+  EXPECT_EQ(warning,
+            "plotter failed on " + d + "/p.gp (still running after 0.5 s: killed); no PNG written");
+  EXPECT_GE(elapsed, 0.5);
+  EXPECT_LT(elapsed, 5.0);
+  EXPECT_FALSE(fs::exists(d + "/p.png"));
+  EXPECT_FALSE(has_temporary_files(d));
+  std::ifstream pid_file(d + "/sleep.pid");
+  std::string   pid;
+  ASSERT_TRUE(std::getline(pid_file, pid));
+  EXPECT_TRUE(process_ends(pid, 5.0)) << "the plotter's child " << pid << " still runs";
+}
+
+TEST(CompareRunPlotter, ASlowGnuplotLeavesTheTablesAndSummaryAndAWarning)
+{
+  const std::string d = fresh_directory("plotter_slow_gnuplot");
+  fs::create_directories(d + "/a");
+  fs::create_directories(d + "/b");
+  for (const auto &run : {"a", "b"})
+    Output::write_file(d + "/" + run + "/probe_0.csv", "time,u_x\n0,0\n1,1\n");
+  const std::string bin = d + "/bin";
+  fs::create_directories(bin);
+  write_script(bin, "gnuplot", "echo partial > probe_0.png.tmp\nexec /bin/sleep 30\n");
+
+  Compare::Options options;
+  options.plot_timeout = 0.3;
+  std::vector<std::string> progress;
+  options.progress = [&progress](const std::string &line) { progress.push_back(line); };
+  Compare::ComparisonReport report;
+  {
+    const ScopedPath fake_gnuplot(fs::absolute(bin).string());
+    report = Compare::compare_directories(d + "/a", "A", d + "/b", "B", {}, d + "/out", options);
+  }
+
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_EQ(report.warnings[0],
+            "gnuplot failed on " + d +
+              "/out/probe_0.gp (still running after 0.3 s: killed); no PNG written");
+  ASSERT_EQ(progress.size(), 1u);
+  EXPECT_EQ(progress[0].find("compare: plot 1/1 probe_0.png not drawn ("), 0u) << progress[0];
+  for (const auto &file : {"probe_0.csv", "probe_0.gp", "summary.csv", "summary.md"})
+    EXPECT_TRUE(fs::exists(d + "/out/" + file)) << file;
+  EXPECT_FALSE(fs::exists(d + "/out/probe_0.png"));
+  EXPECT_FALSE(has_temporary_files(d + "/out"));
 }

@@ -1,6 +1,7 @@
-#ifndef hysteron_base_compare_h
-#define hysteron_base_compare_h
+#ifndef hysteron_source_compare_compare_h
+#define hysteron_source_compare_compare_h
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -12,7 +13,12 @@ namespace hysteron
    * `hysteron --compare`, which runs one scene with two methods (A, e.g. MPM, and
    * B, e.g. FEM). See doc/compare.md for the files and the norms.
    *
-   * Nothing here is collective: call it on one MPI rank.
+   * The module: table.cc reads a CSV table, norms.cc aligns the two time bases
+   * and computes the differences, report.cc writes the side-by-side tables and
+   * the summaries, plots.cc the gnuplot scripts, plotter.cc runs the plotter,
+   * compare_method.cc is the registered method `compare`.
+   *
+   * None of these functions is collective: call them on one MPI rank.
    */
   namespace Compare
   {
@@ -150,11 +156,11 @@ namespace hysteron
     /**
      * Write a gnuplot script that draws @p columns of the side-by-side table
      * @p data_file (written by write_side_by_side()) in a grid of panels, A and
-     * B on the left axis, B - A on the right one, into the PNG @p png_file
-     * (pngcairo). The script plots into "<png_file>.tmp" and renames it, so that
-     * a finished PNG is never replaced by a partial one. File names in the
-     * script are taken as they are: pass names relative to the directory the
-     * script runs in (run_gnuplot() runs it in its own directory).
+     * B on the left axis, B - A on the right one, into "<png_file>.tmp"
+     * (pngcairo), which run_gnuplot() renames to @p png_file once gnuplot has
+     * succeeded: a finished PNG is never replaced by a partial one. File names
+     * in the script are taken as they are: pass names relative to the directory
+     * the script runs in (run_gnuplot() runs it in its own directory).
      */
     void
     write_gnuplot_script(const TableComparison          &comparison,
@@ -165,20 +171,54 @@ namespace hysteron
                          const std::string              &png_file,
                          const std::string              &script_file);
 
+    /// An external plotter that draws one PNG: what run_plotter() runs.
+    struct PlotCommand
+    {
+      /// The program (looked up on PATH unless it names a directory) and its arguments.
+      std::vector<std::string> arguments;
+
+      /// The directory it runs in ("" for the current one).
+      std::string directory;
+
+      /// The PNG it draws, relative to @p directory; the plotter writes "<png_file>.tmp".
+      std::string png_file;
+
+      /// What it draws from, for messages (the script: "out/compare/probe_0.gp").
+      std::string subject;
+
+      /// Seconds it may run (> 0).
+      double timeout = 60;
+    };
+
+    /**
+     * Run a plotter without a shell (posix_spawn with an argument vector, stdin
+     * from /dev/null, stdout and stderr captured, a process group of its own)
+     * and rename its "<png_file>.tmp" to @p png_file once it has exited with
+     * status 0. A plotter still running after the timeout is killed with its
+     * process group. Returns an empty string if the PNG was drawn and the
+     * plotter printed nothing, else a warning: the plotter could not be
+     * started, failed, timed out or drew nothing (then neither the PNG of an
+     * earlier run nor the temporary file is left), or what it printed. Never
+     * throws because of the plotter.
+     */
+    std::string
+    run_plotter(const PlotCommand &command);
+
     /// Whether an executable `gnuplot` is on PATH.
     bool
     gnuplot_available();
 
     /**
-     * Run gnuplot on @p script_file in the script's directory, the PNG it draws
-     * being @p png_file (relative to that directory). Returns an empty string if
-     * the PNG was drawn and gnuplot printed nothing, else a warning: gnuplot not
-     * on PATH or failed (then neither the PNG of an earlier run nor a temporary
-     * file is left under @p png_file), or what gnuplot printed. Never throws
-     * because of gnuplot.
+     * Run gnuplot on @p script_file (written by write_gnuplot_script()) in the
+     * script's directory with run_plotter(), the PNG it draws being @p png_file
+     * (relative to that directory), for at most @p timeout seconds. Returns an
+     * empty string if the PNG was drawn and gnuplot printed nothing, else a
+     * warning: gnuplot not on PATH, failed or timed out (then neither the PNG of
+     * an earlier run nor a temporary file is left under @p png_file), or what
+     * gnuplot printed. Never throws because of gnuplot.
      */
     std::string
-    run_gnuplot(const std::string &script_file, const std::string &png_file);
+    run_gnuplot(const std::string &script_file, const std::string &png_file, double timeout = 60);
 
     /// The outcome of compare_directories().
     struct ComparisonReport
@@ -187,6 +227,9 @@ namespace hysteron
       std::string label_b;
       std::string directory_a;
       std::string directory_b;
+
+      /// The comparison's output directory.
+      std::string output_directory;
 
       /// The tables found in both directories, in the order they were requested.
       std::vector<TableComparison> tables;
@@ -199,7 +242,7 @@ namespace hysteron
       std::vector<std::string> warnings;
     };
 
-    /// Options of compare_directories().
+    /// Options of compare_directories() and write_plots().
     struct Options
     {
       /// Columns to plot (for every table that has them); empty: automatic.
@@ -208,8 +251,14 @@ namespace hysteron
       /// At most this many panels per plot in the automatic choice.
       unsigned int max_plot_columns = 12;
 
-      /// Write the gnuplot scripts (and run gnuplot if it is on PATH).
+      /// compare_directories() draws the plots (write_plots()).
       bool plots = true;
+
+      /// Seconds one plot may take before the plotter is killed.
+      double plot_timeout = 60;
+
+      /// Called with a line of progress per plot (none if empty).
+      std::function<void(const std::string &)> progress;
     };
 
     /// Write summary.csv: one row per (table, column), sorted by table then column.
@@ -228,9 +277,9 @@ namespace hysteron
      * input directory):
      *
      * - <stem>.csv: the side-by-side table of every table present in both,
-     * - <stem>.gp and <stem>.png: its plot (the PNG only if gnuplot is on PATH),
      * - summary.csv and summary.md over all tables, naming tables present in
-     *   only one directory and columns present in only one table.
+     *   only one directory and columns present in only one table,
+     * - with Options::plots, then, the plots (write_plots()).
      *
      * All inputs are read and compared before anything is written: an unreadable
      * or malformed table (InputError naming file and line) leaves no output.
@@ -246,6 +295,16 @@ namespace hysteron
                         const std::vector<std::string> &files,
                         const std::string              &out_dir,
                         const Options                  &options = Options());
+
+    /**
+     * Draw the plots of @p report (made by compare_directories()) in its output
+     * directory: for every compared table with a column to draw,
+     * <stem>.gp and, with gnuplot on PATH, <stem>.png (run_gnuplot(), at most
+     * Options::plot_timeout seconds each). Adds a warning to @p report for every
+     * plot not made; never throws because of gnuplot.
+     */
+    void
+    write_plots(ComparisonReport &report, const Options &options = Options());
   } // namespace Compare
 } // namespace hysteron
 
