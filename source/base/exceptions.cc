@@ -2,7 +2,7 @@
 
 namespace hysteron
 {
-  InputError::InputError(const std::string &where, const std::string &problem)
+  LocatedError::LocatedError(const std::string &where, const std::string &problem)
     : std::runtime_error(where + ": " + problem)
     , where_(where)
     , problem_(problem)

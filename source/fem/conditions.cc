@@ -91,23 +91,10 @@ namespace hysteron
               dirichlet.push_back(set);
               continue;
             }
+          const auto [lower, upper] = mesh_box.get_boundary_points();
           for (const auto &[dof, p] : support)
-            {
-              const unsigned int c = component[dof];
-              for (const unsigned int face : d.faces)
-                {
-                  const unsigned int dir = face / 2;
-                  const double       x   = face % 2 == 0 ? mesh_box.lower_bound(dir) :
-                                                            mesh_box.upper_bound(dir);
-                  if (std::abs(p[dir] - x) <= tolerance &&
-                      (d.type != Type::roller || c == dir) &&
-                      (d.type == Type::fixed || d.type == Type::roller || d.components[c]))
-                    add(set, dof, c, index);
-                }
-              if (d.has_region && d.region.contains(p, tolerance) &&
-                  (d.type == Type::fixed || d.components[c]))
-                add(set, dof, c, index);
-            }
+            if (d.prescribes(p, component[dof], lower, upper, tolerance))
+              add(set, dof, component[dof], index);
           const unsigned long n = dealii::Utilities::MPI::sum<unsigned long>(set.dofs.size(), scene.mpi_communicator());
           require(n > 0,
                   "Boundary " + d.name + (d.has_region ? "/Region" : "/Faces"),

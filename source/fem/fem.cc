@@ -266,6 +266,7 @@ namespace hysteron
       setup_system();
       setup_history();
       setup_dirichlet();
+      check_supports();
       setup_loads();
       setup_probes();
       setup_dynamics();

@@ -94,7 +94,7 @@ namespace hysteron
         prm.declare_entry("Steps",
                           "1000",
                           Patterns::Integer(),
-                          "Number of equal strain increments (material updates), >= 1.");
+                          "Number of equal strain increments (material updates), 1 to 10^7.");
         prm.declare_entry("Material",
                           "",
                           Patterns::Anything(),
@@ -117,9 +117,10 @@ namespace hysteron
       end_time = s.get_positive("End time");
       {
         const long steps = s.get_integer("Steps");
-        require(steps >= 1 && steps <= 2000000000L,
+        require(steps >= 1 && steps <= 10000000L,
                 s.where("Steps"),
-                "must be an integer >= 1 (got " + s.get("Steps") + ")");
+                "must be an integer from 1 to 10,000,000 (each step is a row of history.csv, kept "
+                "in memory too; got " + s.get("Steps") + ")");
         n_steps = steps;
       }
       tolerance = s.get_positive("Mixed control tolerance");
@@ -161,7 +162,10 @@ namespace hysteron
           comp.name = component_names[c];
           comp.free = free;
           if (!free)
-            comp.strain = parse_function<1>(expr, "t", false, s.where(entry));
+            {
+              comp.strain = parse_function<1>(expr, "t", false, s.where(entry));
+              check_finite_in_time(*comp.strain, end_time);
+            }
           components.push_back(std::move(comp));
         }
       require(std::any_of(components.begin(),

@@ -32,7 +32,7 @@ namespace hysteron
                           "1000",
                           Patterns::Integer(),
                           "Number of equal time steps (strain increments, updates of the law), "
-                          ">= 1.");
+                          "1 to 10^7.");
       }
       prm.leave_subsection();
 
@@ -55,14 +55,16 @@ namespace hysteron
         Section s(prm, {"Uniaxial"});
         end_time         = s.get_positive("End time");
         const long steps = s.get_integer("Steps");
-        require(steps >= 1 && steps <= 2000000000L,
+        require(steps >= 1 && steps <= 10000000L,
                 s.where("Steps"),
-                "must be an integer >= 1 (got " + s.get("Steps") + ")");
+                "must be an integer from 1 to 10,000,000 (each step is a row of history.csv, kept "
+                "in memory too; got " + s.get("Steps") + ")");
         n_steps = steps;
         strain  = parse_function<1>(dealii::Utilities::trim(s.get("Strain")),
                                    "t",
                                    false,
                                    s.where("Strain"));
+        check_finite_in_time(*strain, end_time);
       }
 
       Section                        material(prm, {"Material"});

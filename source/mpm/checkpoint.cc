@@ -66,6 +66,8 @@ namespace hysteron
     {
       using namespace dealii;
       auto &P = particles;
+      // What the conditions did before the checkpoint is not stored: no idle warning.
+      boundary_acted.assign(boundaries.size(), true);
       in.section("mpm points");
       in.get(P.id);
       const std::size_t n = P.id.size();

@@ -5,6 +5,8 @@
 #include <hysteron/mpm/mpm.h>
 
 #include <algorithm>
+#include <iostream>
+#include <sstream>
 
 namespace hysteron
 {
@@ -50,11 +52,43 @@ namespace hysteron
           const unsigned long n_nodes = dealii::Utilities::MPI::sum<unsigned long>(
             std::count_if(b.nodes.begin(), b.nodes.end(), [&](const unsigned int n) { return grid->is_owned(n); }),
             grid->mpi_communicator());
-          require(n_nodes > 0 || description.type != Type::fixed || !description.has_region,
-                  "Boundary " + description.name + "/Region",
-                  "the region contains no grid node");
+          // A condition acts on grid nodes: one that selects none acts on nothing.
+          require(n_nodes > 0,
+                  "Boundary " + description.name + (description.has_region ? "/Region" : "/Faces"),
+                  "selects no grid node (the background grid is " + grid_extent() + ")");
           boundaries.push_back(std::move(b));
         }
+      boundary_acted.assign(boundaries.size(), false);
+    }
+
+
+
+    template <int dim>
+    std::string
+    Solver<dim>::grid_extent() const
+    {
+      const auto        &lattice = grid->lattice();
+      std::ostringstream s;
+      for (unsigned int d = 0; d < dim; ++d)
+        s << (d > 0 ? " x [" : "[") << lattice.origin[d] << ", "
+          << lattice.origin[d] + lattice.n_cells[d] * lattice.h << "]";
+      return s.str();
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::warn_about_idle_boundaries() const
+    {
+      const Scene<dim> &scene = this->get_scene();
+      for (unsigned int b = 0; b < boundaries.size(); ++b)
+        if (dealii::Utilities::MPI::max(boundary_acted[b] ? 1 : 0, grid->mpi_communicator()) == 0 &&
+            scene.is_root())
+          std::cerr << "hysteron: warning: Boundary " << boundaries[b].name
+                    << ": no material point came near its grid nodes during the run, so it "
+                       "acted on nothing (check its Faces or Region)"
+                    << std::endl;
     }
 
 
@@ -98,6 +132,7 @@ namespace hysteron
               double *const      r = node + std::size_t(n) * C;
               if (!(r[0] > small_mass))
                 continue;
+              boundary_acted[b] = true;
               const unsigned int d = bc.normal_direction[k];
               switch (type)
                 {
@@ -149,6 +184,10 @@ namespace hysteron
 
     template void Solver<2>::setup_boundaries();
     template void Solver<3>::setup_boundaries();
+    template std::string Solver<2>::grid_extent() const;
+    template std::string Solver<3>::grid_extent() const;
+    template void Solver<2>::warn_about_idle_boundaries() const;
+    template void Solver<3>::warn_about_idle_boundaries() const;
     template void Solver<2>::apply_boundary_conditions(double, double, bool);
     template void Solver<3>::apply_boundary_conditions(double, double, bool);
   } // namespace MPM

@@ -133,6 +133,10 @@ namespace hysteron
             require(upper[d] > lower[d],
                     grid_section.where("Upper corner"),
                     std::string("must be above the lower corner in ") + component_suffix[d]);
+            require(cell_size <= (upper[d] - lower[d]) * (1 + 1e-9),
+                    grid_section.where("Cell size"),
+                    "is larger than the grid (" + grid_section.get("Cell size") + " m; the grid is " +
+                      std::to_string(upper[d] - lower[d]) + " m wide in " + component_suffix[d] + ")");
             const double n = std::ceil((upper[d] - lower[d]) / cell_size - 1e-9);
             require(n <= 1e6,
                     grid_section.where("Cell size"),
@@ -432,6 +436,7 @@ namespace hysteron
     {
       if (particle_table)
         write_particle_table();
+      warn_about_idle_boundaries();
     }
 
 

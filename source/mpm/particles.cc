@@ -10,6 +10,7 @@
 #include <cmath>
 #include <functional>
 #include <numeric>
+#include <sstream>
 
 namespace hysteron
 {
@@ -51,6 +52,21 @@ namespace hysteron
                 ++points_per_cell[id];
               }
         }
+      // Two bodies in one place would put two material points (twice the mass) there.
+      const auto &bodies = scene.body_descriptions();
+      for (unsigned int b = 1; b < bodies.size(); ++b)
+        for (unsigned int a = 0; a < b; ++a)
+          {
+            unsigned long n_inside = 0;
+            for (const auto &x : body_points[b])
+              n_inside += bodies[a].shape.contains(x) ? 1 : 0;
+            require(n_inside == 0,
+                    "Body " + bodies[b].name + "/Shape",
+                    "overlaps Body " + bodies[a].name + ": " + std::to_string(n_inside) + " of its " +
+                      std::to_string(body_points[b].size()) +
+                      " material points lie inside that body's shape (two bodies in one place would "
+                      "double the mass there)");
+          }
       grid = std::make_unique<BackgroundGrid<dim>>(scene.mpi_communicator());
       grid->initialize(lower, cell_size, n_cells, 1 + 2 * dim, points_per_cell);
       node_stamp.assign(grid->n_local_nodes(), 0);
@@ -176,6 +192,20 @@ namespace hysteron
               handler->insert_particle(x, reference, id, grid->cell_iterator(cid), make_array_view(properties));
             }
         }
+      // A probe follows its nearest material point; a point farther than a grid
+      // cell diagonal from every one of them lies outside the deformable bodies.
+      for (unsigned int i = 0; i < probes.size(); ++i)
+        if (!(best_distance[i] <= std::sqrt(double(dim)) * lattice.h))
+          {
+            std::ostringstream what;
+            what << "the point (" << probes[i].point << ") lies outside the deformable bodies: ";
+            if (best_distance[i] < std::numeric_limits<double>::max())
+              what << "the nearest material point is " << best_distance[i] << " m away (more than a grid "
+                   << "cell diagonal, " << std::sqrt(double(dim)) * lattice.h << " m)";
+            else
+              what << "the scene has no deformable body";
+            throw InputError("Output/Probe points", what.str());
+          }
       n_global_particles = next_id;
       body_points.clear();
       body_points.shrink_to_fit();

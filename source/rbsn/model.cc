@@ -15,34 +15,6 @@ namespace hysteron
 {
   namespace RBSN
   {
-    namespace
-    {
-      std::vector<dealii::Point<2>>
-      parse_point_list(const std::string &text, const std::string &where)
-      {
-        std::vector<dealii::Point<2>> points;
-        for (const auto &item : dealii::Utilities::split_string_list(text, ';'))
-          {
-            if (item.empty())
-              continue;
-            const auto c = dealii::Utilities::split_string_list(item, ',');
-            require(c.size() == 2, where, "the point '" + item + "' needs 2 coordinates");
-            try
-              {
-                points.emplace_back(dealii::Utilities::string_to_double(c[0]),
-                                    dealii::Utilities::string_to_double(c[1]));
-              }
-            catch (...)
-              {
-                throw InputError(where, "cannot read the point '" + item + "'");
-              }
-          }
-        return points;
-      }
-    } // namespace
-
-
-
     void
     Model::declare_parameters(dealii::ParameterHandler &prm)
     {
@@ -161,7 +133,7 @@ namespace hysteron
         Section s(prm, {"RBSN"});
         d_m                = s.get_positive("Minimum distance");
         points_on_boundary = s.get_bool("Points on the boundary");
-        extra_points       = parse_point_list(s.get("Additional points"), s.where("Additional points"));
+        extra_points       = parse_points<2>(s.get("Additional points"), s.where("Additional points"));
         boundary_h         = s.get_non_negative("Curved boundary resolution");
         if (boundary_h == 0)
           boundary_h = 0.25 * d_m;
@@ -238,6 +210,15 @@ namespace hysteron
       // random points (one set for all bodies; each point belongs to the body
       // that contains it).
       std::vector<dealii::Point<2>> fixed = extra_points;
+      for (const auto &p : extra_points)
+        {
+          bool inside = false;
+          for (const auto *shape : body_shapes)
+            inside = inside || shape->contains(p, 1e-9 * d_m);
+          std::ostringstream point;
+          point << p;
+          require(inside, "RBSN/Additional points", "the point (" + point.str() + ") lies in no deformable body");
+        }
       if (points_on_boundary)
         for (const auto *shape : body_shapes)
           {
@@ -255,6 +236,15 @@ namespace hysteron
             unique.push_back(p);
         }
       std::vector<dealii::Point<2>> points = unique;
+      // A saturated Poisson-disk set has about 0.68 A / d_m^2 points: say so when the
+      // set-up (sampling and Voronoi cells) will take noticeable time.
+      double area = 0;
+      for (const auto *shape : body_shapes)
+        area += shape->bounding_box().volume();
+      if (const double estimate = 0.68 * area / (d_m * d_m); estimate > 2e5)
+        scene.console() << "rbsn: placing up to about " << static_cast<long>(estimate)
+                        << " nuclei (d_m = " << d_m << " m) and their Voronoi cells; this set-up "
+                        << "takes a while" << std::endl;
       for (unsigned int s = 0; s < body_shapes.size(); ++s)
         {
           // Each body is filled in turn, keeping d_m from every point so far.
@@ -262,6 +252,11 @@ namespace hysteron
                                             scene.random_seed() + 7919 * s, "RBSN/Minimum distance");
           points.swap(filled);
         }
+      require(points.size() >= 2,
+              "RBSN/Minimum distance",
+              "leaves room for " + std::to_string(points.size()) +
+                " nucleus in the bodies, and a network needs at least two cells: the minimum "
+                "distance must be well below the size of the bodies (got " + std::to_string(d_m) + " m)");
       network = voronoi(points, body_shapes, boundary_h, "Body names");
 
       // The bodies and the rigid-body mass properties about the nuclei (eq. 3.12).
@@ -406,15 +401,9 @@ namespace hysteron
             set.dofs.push_back(dof);
           }
       };
-      // velocity / displacement: the selected components; with both, also the rotation
-      // (the rigid motion of the cell that the field gives its nucleus).
-      const auto take_prescribed = [&](Dirichlet &set, const unsigned int c, const BoundaryDescription<2> &d) {
-        for (unsigned int k = 0; k < 2; ++k)
-          if (d.components[k])
-            take(set, 3 * c + k);
-        if (d.components[0] && d.components[1])
-          take(set, 3 * c + 2);
-      };
+      // u and v by the boundary's rule; the rotation with both (fixed, or velocity /
+      // displacement of x and y: the rigid motion the field gives the nucleus), not
+      // for a roller.
       for (unsigned int b = 0; b < scene.boundary_descriptions().size(); ++b)
         {
           const auto &d = scene.boundary_descriptions()[b];
@@ -424,29 +413,14 @@ namespace hysteron
           for (unsigned int c = 0; c < network.cells.size(); ++c)
             {
               const auto &x = network.cells[c].nucleus;
-              for (const unsigned int face : d.faces)
-                {
-                  const unsigned int dir = face / 2;
-                  const double       at  = face % 2 == 0 ? box.first[dir] : box.second[dir];
-                  if (std::abs(x[dir] - at) <= tolerance)
-                    {
-                      if (d.type == Type::fixed)
-                        for (unsigned int k = 0; k < 3; ++k)
-                          take(set, 3 * c + k);
-                      else if (d.type == Type::roller)
-                        take(set, 3 * c + dir);
-                      else
-                        take_prescribed(set, c, d);
-                    }
-                }
-              if (d.has_region && d.region.contains(x, tolerance))
-                {
-                  if (d.type == Type::fixed)
-                    for (unsigned int k = 0; k < 3; ++k)
-                      take(set, 3 * c + k);
-                  else
-                    take_prescribed(set, c, d);
-                }
+              bool        both = d.type != Type::roller;
+              for (unsigned int k = 0; k < 2; ++k)
+                if (d.prescribes(x, k, box.first, box.second, tolerance))
+                  take(set, 3 * c + k);
+                else
+                  both = false;
+              if (both)
+                take(set, 3 * c + 2);
             }
           require(!set.dofs.empty(),
                   "Boundary " + d.name + (d.has_region ? "/Region" : "/Faces"),
@@ -692,6 +666,13 @@ namespace hysteron
     Solver<dim>::setup()
     {
       model->setup();
+    }
+
+    template <int dim>
+    double
+    Solver<dim>::size_of_state() const
+    {
+      return model ? 3.0 * model->tessellation().cells.size() : 0.0; // u, v, theta per cell
     }
 
     template <int dim>

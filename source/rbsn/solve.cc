@@ -428,6 +428,7 @@ namespace hysteron
       setup_springs();
       setup_system();
       setup_conditions();
+      check_supports();
       locate_probes();
       scene.console() << "rbsn: " << network.cells.size() << " cells, " << network.facets.size()
                       << " facets (d_m = " << d_m << " m), " << 3 * network.cells.size() << " DoFs"

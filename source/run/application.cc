@@ -273,6 +273,13 @@ namespace hysteron
         report("run-time error", e.what());
         return 2;
       }
+    catch (const NonFiniteExpression &e)
+      {
+        // Found during the run (between the times checked up front): the tables
+        // hold every step before it.
+        report("run-time error", e.what());
+        return 2;
+      }
     catch (const Interrupted &e)
       {
         report("interrupted", e.what());

@@ -18,6 +18,37 @@ namespace hysteron
 
     namespace
     {
+      /**
+       * The position of the first byte that cannot be in a UTF-8 text file: a control
+       * character other than tab, line feed, carriage return and form feed, or a byte
+       * sequence that is not UTF-8 (a stray continuation byte, a truncated or overlong
+       * sequence); npos for a text file.
+       */
+      std::size_t
+      first_non_text(const std::string &s)
+      {
+        for (std::size_t i = 0; i < s.size();)
+          {
+            const unsigned char c = s[i];
+            if (c < 0x80)
+              {
+                if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r' && c != '\f') || c == 0x7f)
+                  return i;
+                ++i;
+                continue;
+              }
+            // The lead byte gives the length; C0, C1 and F5..FF never occur.
+            const std::size_t n = c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
+            if (n == 0 || i + n > s.size())
+              return i;
+            for (std::size_t k = 1; k < n; ++k)
+              if ((static_cast<unsigned char>(s[i + k]) & 0xc0) != 0x80)
+                return i;
+            i += n;
+          }
+        return std::string::npos;
+      }
+
       constexpr std::size_t max_size  = 16u << 20;
       constexpr unsigned    max_depth = 16;
 
@@ -65,6 +96,16 @@ namespace hysteron
         if (const auto nul = content.find('\0'); nul != std::string::npos)
           throw InputError(where(file, 1 + std::count(content.begin(), content.begin() + nul, '\n')),
                            "not a text file (a NUL byte): not a parameter file");
+        if (const auto bad = first_non_text(content); bad != std::string::npos)
+          {
+            std::ostringstream byte;
+            byte << "0x" << std::hex << std::uppercase
+                 << static_cast<unsigned int>(static_cast<unsigned char>(content[bad]));
+            throw InputError(where(file, 1 + std::count(content.begin(), content.begin() + bad, '\n')),
+                             "not UTF-8 text (byte " + byte.str() +
+                               "): not a parameter file, or one saved in another encoding (save it "
+                               "as UTF-8)");
+          }
 
         stack.emplace_back(canonical, file);
         std::istringstream lines(content);
@@ -118,6 +159,7 @@ namespace hysteron
 
       // What deal.II accepts silently: no entry at all, an entry set twice.
       std::vector<std::string>                                       path;
+      std::vector<std::pair<std::string, unsigned int>>              opened; // where each path entry began
       std::map<std::string, std::pair<std::string, unsigned int>> seen;
       bool                                                           any = false;
       std::istringstream                                             lines(file.text);
@@ -142,11 +184,16 @@ namespace hysteron
             {
               any = true;
               path.push_back(dealii::Utilities::trim(words.substr(10)));
+              opened.push_back(file.origin[first - 1]);
             }
           else if (words == "end")
             {
-              if (!path.empty())
-                path.pop_back();
+              const auto &at = file.origin[first - 1];
+              require(!path.empty(),
+                      where(at.first, at.second),
+                      "`end` without an open subsection (one `end` too many)");
+              path.pop_back();
+              opened.pop_back();
             }
           else if (words.rfind("set", 0) == 0 && words.size() > 3 &&
                    (words[3] == ' ' || words[3] == '\t') && words.find('=') != std::string::npos)
@@ -169,6 +216,10 @@ namespace hysteron
               seen.emplace(key, at);
             }
         }
+      if (!path.empty())
+        throw InputError(where(opened.back().first, opened.back().second),
+                         "`subsection " + path.back() + "` is never closed: an `end` is missing "
+                         "inside it or after it");
       require(any,
               filename,
               "the parameter file sets nothing (no `set` and no `subsection`): an empty scene would "

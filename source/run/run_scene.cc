@@ -41,12 +41,20 @@ namespace hysteron
       wall.start();
       scene.console() << "hysteron " HYSTERON_VERSION ": " << dim << "D scene '"
                       << options.parameter_file << "', method '" << name << "'" << std::endl;
-      {
-        dealii::TimerOutput::Scope timing(scene.timer(), "set-up");
-        method.setup();
-      }
-      if (const std::string problem = method.check_size(); !problem.empty())
-        throw InputError("Time", problem);
+      try
+        {
+          {
+            dealii::TimerOutput::Scope timing(scene.timer(), "set-up");
+            method.setup();
+          }
+          if (const std::string problem = method.check_size(); !problem.empty())
+            throw InputError("Time", problem);
+        }
+      catch (const NonFiniteExpression &e)
+        {
+          // Evaluated during the set-up (an initial velocity at a point): bad input.
+          throw InputError(e.where(), e.problem());
+        }
 
       // Only a scene that set up without a problem writes files.
       RunDescription description;

@@ -73,6 +73,26 @@ namespace hysteron
   }
 
   template <int dim>
+  bool
+  BoundaryDescription<dim>::prescribes(const dealii::Point<dim> &x,
+                                       const unsigned int        c,
+                                       const dealii::Point<dim> &lower,
+                                       const dealii::Point<dim> &upper,
+                                       const double              tolerance) const
+  {
+    if (type == Type::wall)
+      return false;
+    for (const unsigned int face : faces)
+      {
+        const unsigned int d = face / 2;
+        if (std::abs(x[d] - (face % 2 == 0 ? lower[d] : upper[d])) <= tolerance &&
+            (type == Type::fixed || (type == Type::roller ? c == d : bool(components[c]))))
+          return true;
+      }
+    return has_region && region.contains(x, tolerance) && (type == Type::fixed || components[c]);
+  }
+
+  template <int dim>
   dealii::Tensor<1, dim>
   BoundaryDescription<dim>::displacement_increment(const double              t0,
                                                    const double              t1,

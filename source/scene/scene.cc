@@ -176,40 +176,6 @@ namespace hysteron
     Methods::Registry<3>::declare_parameters(prm);
   }
 
-  namespace
-  {
-    template <int dim>
-    std::vector<dealii::Point<dim>>
-    parse_points(const std::string &text, const std::string &where)
-    {
-      std::vector<dealii::Point<dim>> points;
-      for (const auto &item : dealii::Utilities::split_string_list(text, ';'))
-        {
-          if (item.empty())
-            continue;
-          std::vector<double> coordinates;
-          try
-            {
-              coordinates =
-                dealii::Utilities::string_to_double(dealii::Utilities::split_string_list(item, ','));
-            }
-          catch (...)
-            {
-              throw InputError(where, "cannot read the point '" + item + "'");
-            }
-          require(coordinates.size() == dim,
-                  where,
-                  "the point '" + item + "' has " + std::to_string(coordinates.size()) +
-                    " coordinates; a " + std::to_string(dim) + "D scene needs " +
-                    std::to_string(dim));
-          dealii::Point<dim> p;
-          for (unsigned int d = 0; d < dim; ++d)
-            p[d] = coordinates[d];
-          points.push_back(p);
-        }
-      return points;
-    }
-  } // namespace
 
   template <int dim>
   Scene<dim>::Scene(dealii::ParameterHandler &prm, const RunOptions &options)
@@ -289,6 +255,15 @@ namespace hysteron
       material(b.material, "Body " + b.name + "/Material");
     boundaries = parse_boundaries<dim>(prm, scene_names);
     loads      = parse_loads<dim>(prm, scene_names);
+    // Expressions of time only: NaN or infinity anywhere in [0, End time] is bad input.
+    for (const auto &b : bodies)
+      if (b.rigid_velocity)
+        check_finite_in_time(*b.rigid_velocity, time.end_time);
+    for (const auto &b : boundaries)
+      if (b.velocity)
+        check_finite_in_time(*b.velocity, time.end_time);
+    for (const auto &l : loads)
+      check_finite_in_time(*l.value, time.end_time);
 
     std::ostringstream text;
     prm.print_parameters(text, dealii::ParameterHandler::ShortPRM);

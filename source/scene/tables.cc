@@ -3,6 +3,9 @@
 #include <hysteron/scene/scene.h>
 #include <hysteron/scene/tables.h>
 
+#include <cmath>
+#include <sstream>
+
 namespace hysteron
 {
   namespace PointData
@@ -14,6 +17,8 @@ namespace hysteron
                       const std::vector<std::string> &point)
     {
       n_values         = point.size();
+      point_names      = point;
+      reaction_names   = reaction_columns(scene);
       if (!scene.is_root())
         return;
       const auto file = [&](const std::string &name) { return directory + "/" + name; };
@@ -71,31 +76,69 @@ namespace hysteron
             for (unsigned int d = 0; d < dim; ++d)
               r[d] = *p++;
         }
-      // Only the scene's root opened the tables (comm may be a method's own, e.g.
-      // MPI_COMM_SELF for a method that every rank runs whole).
-      if (energy_table == nullptr)
-        return;
-      for (unsigned int i = 0; i < probe_tables.size(); ++i)
+      // The rows on every rank (the values are the same after the reduction), so that
+      // a non-finite value stops every rank.
+      std::vector<std::vector<double>> probe_rows, average_rows;
+      std::vector<std::string>         names{"time"};
+      names.insert(names.end(), point_names.begin(), point_names.end());
+      for (unsigned int i = 0; i < probes.size() / std::max(1u, n_values); ++i)
         {
           std::vector<double> row{t};
           row.insert(row.end(), probes.begin() + i * n_values, probes.begin() + (i + 1) * n_values);
-          probe_tables[i]->add_row(row);
+          check_finite(t, row, "probe_" + std::to_string(i) + ".csv", names);
+          probe_rows.push_back(std::move(row));
         }
-      for (unsigned int i = 0; i < average_tables.size(); ++i)
+      names.insert(names.begin() + 1, "mass");
+      for (unsigned int i = 0; i < averages.size() / (1 + n_values); ++i)
         {
           const double       *a = averages.data() + i * (1 + n_values);
           std::vector<double> row{t, a[0]};
           for (unsigned int c = 0; c < n_values; ++c)
             row.push_back(a[0] > 0 ? a[1 + c] / a[0] : 0.0);
-          average_tables[i]->add_row(row);
+          check_finite(t, row, "average_" + std::to_string(i) + ".csv", names);
+          average_rows.push_back(std::move(row));
         }
-      energy_table->add_row(
-        energy_log.row(t, energies[0], energies[1], energies[2], energies[3], energies[4]));
-      std::vector<double> row{t};
+      const std::vector<double> energy_row =
+        energy_log.row(t, energies[0], energies[1], energies[2], energies[3], energies[4]);
+      check_finite(t, energy_row, "energy.csv", energy_columns());
+      std::vector<double> reaction_row{t};
       for (const auto &r : reactions)
         for (unsigned int d = 0; d < dim; ++d)
-          row.push_back(r[d]);
-      reaction_table->add_row(row);
+          reaction_row.push_back(r[d]);
+      check_finite(t, reaction_row, "reactions.csv", reaction_names);
+
+      // Only the scene's root opened the tables (comm may be a method's own, e.g.
+      // MPI_COMM_SELF for a method that every rank runs whole).
+      if (energy_table == nullptr)
+        return;
+      for (unsigned int i = 0; i < probe_tables.size(); ++i)
+        probe_tables[i]->add_row(probe_rows[i]);
+      for (unsigned int i = 0; i < average_tables.size(); ++i)
+        average_tables[i]->add_row(average_rows[i]);
+      energy_table->add_row(energy_row);
+      reaction_table->add_row(reaction_row);
+    }
+
+
+
+    template <int dim>
+    void
+    Tables<dim>::check_finite(const double                    t,
+                              const std::vector<double>      &row,
+                              const std::string              &table,
+                              const std::vector<std::string> &names)
+    {
+      for (unsigned int c = 0; c < row.size(); ++c)
+        if (!std::isfinite(row[c]))
+          {
+            std::ostringstream m;
+            m << table << ": " << (c < names.size() ? names[c] : "column " + std::to_string(c)) << " = "
+              << row[c] << " at t = " << t
+              << " s: the solution overflowed or became NaN (the tables hold every row before). "
+                 "Check the magnitudes and units of the scene: material constants, loads, "
+                 "prescribed motions";
+            throw RuntimeError(m.str());
+          }
     }
 
 

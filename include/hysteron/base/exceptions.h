@@ -7,15 +7,14 @@
 namespace hysteron
 {
   /**
-   * An error in what the user gave us: a parameter value, an expression, a file.
-   * `where` names the parameter path ("Material/Young's modulus") or the file;
-   * `problem` says what is wrong with it. The `hysteron` executable prints
-   * "error: <where>: <problem>" and exits with status 1.
+   * An error that names its place: `where` is the parameter path ("Material/Young's
+   * modulus") or the file, `problem` says what is wrong there; what() is
+   * "<where>: <problem>".
    */
-  class InputError : public std::runtime_error
+  class LocatedError : public std::runtime_error
   {
   public:
-    InputError(const std::string &where, const std::string &problem);
+    LocatedError(const std::string &where, const std::string &problem);
 
     const std::string &
     where() const
@@ -35,6 +34,17 @@ namespace hysteron
   };
 
   /**
+   * An error in what the user gave us: a parameter value, an expression, a file.
+   * The `hysteron` executable prints "error: <where>: <problem>" and exits with
+   * status 1.
+   */
+  class InputError : public LocatedError
+  {
+  public:
+    using LocatedError::LocatedError;
+  };
+
+  /**
    * A failure while running a valid scene: a NaN, a non-converging local Newton
    * iteration, an unstable time step. The message says what, where and when; the
    * executable prints it and exits with status 2.
@@ -43,6 +53,20 @@ namespace hysteron
   {
   public:
     explicit RuntimeError(const std::string &message);
+  };
+
+  /**
+   * A user's expression evaluated to NaN or infinity during a run (a division by
+   * zero, log(0), the root of a negative number). Deliberately not a RuntimeError:
+   * the methods cut a step on a RuntimeError (a material that failed to
+   * converge), and a smaller step does not cure a wrong expression. The
+   * executable ends the run with exit status 2 and this message, which names the
+   * entry, the expression, the value and the point and time of the evaluation.
+   */
+  class NonFiniteExpression : public LocatedError
+  {
+  public:
+    using LocatedError::LocatedError;
   };
 
   /**

@@ -79,7 +79,11 @@ namespace hysteron
    * Parse a muParser expression in the variables @p variables (e.g. "t" or
    * "x,y,t"), with the constants pi and e. The expression is evaluated once at
    * the origin so that unknown names and syntax errors are reported here, as an
-   * InputError at @p where, and not in the middle of a run.
+   * InputError at @p where, and not in the middle of a run. `rand()` is refused
+   * (a new number at every evaluation would break the reproducibility that
+   * `Random seed` promises; `rand_seed(<integer>)` is deterministic).
+   * Every value the function returns is checked: NaN or infinity throws
+   * NonFiniteExpression naming @p where, the expression, the point and the time.
    * @p time_dependent: the last variable is time (FunctionParser convention).
    */
   template <int dim>
@@ -100,6 +104,28 @@ namespace hysteron
                         const std::string &variables,
                         const bool         time_dependent,
                         const std::string &where);
+
+  /**
+   * Evaluate every component of the function of time @p f (a FunctionParser<1>
+   * in t from parse_function()) at @p n_samples + 1 equidistant times of
+   * [0, @p end_time]: an expression that is NaN or infinite there (1/(t - 1),
+   * log(t), sqrt(0.5 - t)) is refused as an InputError before the run starts,
+   * with the time. The check during the run catches what falls between samples.
+   */
+  void
+  check_finite_in_time(const dealii::Function<1> &f,
+                       const double               end_time,
+                       const unsigned int         n_samples = 1000);
+
+  /**
+   * Points separated by ';', each of @p dim finite coordinates separated by ','
+   * ("0.5, 0.1; 1, 0.1"); empty items are skipped. A point that does not read,
+   * has the wrong number of coordinates or a NaN/infinite coordinate is an
+   * InputError at @p where.
+   */
+  template <int dim>
+  std::vector<dealii::Point<dim>>
+  parse_points(const std::string &text, const std::string &where);
 
   /// Names in a top-level list entry such as "Material names" (validated: no
   /// duplicates, no empty names, no characters that would break a subsection name).

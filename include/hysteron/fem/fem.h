@@ -112,6 +112,11 @@ namespace hysteron
       {
         return "fem";
       }
+      double
+      size_of_state() const override
+      {
+        return dof_handler.n_dofs();
+      }
       std::string
       field_name() const override
       {
@@ -218,6 +223,9 @@ namespace hysteron
       setup_history();
       void
       setup_dirichlet();
+      /// Quasi-static: refuse a mesh part whose rigid-body motions are free (supports.cc).
+      void
+      check_supports() const;
       void
       setup_loads();
       void

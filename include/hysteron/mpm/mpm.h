@@ -93,6 +93,11 @@ namespace hysteron
       {
         return "mpm";
       }
+      double
+      size_of_state() const override
+      {
+        return n_global_particles;
+      }
       std::string
       field_name() const override
       {
@@ -162,6 +167,12 @@ namespace hysteron
       generate_particles();
       void
       setup_boundaries();
+      /// "[x0, x1] x [y0, y1]": the background grid, for messages.
+      std::string
+      grid_extent() const;
+      /// A warning for every boundary condition that constrained no node with mass.
+      void
+      warn_about_idle_boundaries() const;
       void
       from_handler();
       void
@@ -232,6 +243,7 @@ namespace hysteron
       std::unique_ptr<dealii::Particles::ParticleHandler<dim>> handler;
       ParticleStore<dim>                                 particles;
       std::vector<BoundaryNodes>                         boundaries;
+      std::vector<bool> boundary_acted; ///< per boundary: has it constrained a node with mass
       std::vector<Probe>                                 probes;
       std::vector<dealii::Tensor<1, dim>>                load_per_point; ///< per load, at t
       std::vector<double>                                load_scale;     ///< 1 / count or area

@@ -202,6 +202,9 @@ namespace hysteron
       setup_system();
       void
       setup_conditions();
+      /// Static analyses: refuse a network part whose rigid-body motions are free (supports.cc).
+      void
+      check_supports() const;
 
       // Steps.
       void

@@ -55,6 +55,8 @@ namespace hysteron
       {
         return "rbsn";
       }
+      double
+      size_of_state() const override;
       std::string
       field_name() const override
       {

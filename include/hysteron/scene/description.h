@@ -94,6 +94,22 @@ namespace hysteron
     dealii::Tensor<1, dim>
     displacement_increment(const double t0, const double t1, const dealii::Point<dim> &x) const;
 
+    /**
+     * Does this condition prescribe displacement component @p c at the node @p x of
+     * a model whose nodes span the box [@p lower, @p upper]? Through a face of the
+     * box (x within @p tolerance of it): every component (fixed), the face normal
+     * (roller), the `Components` (velocity, displacement); through the Region:
+     * every component (fixed) or the `Components`. Walls prescribe nothing (they
+     * are unilateral). The FEM (nodes) and the RBSN (cell nuclei) select their
+     * Dirichlet DoFs with this one rule.
+     */
+    bool
+    prescribes(const dealii::Point<dim> &x,
+               const unsigned int        c,
+               const dealii::Point<dim> &lower,
+               const dealii::Point<dim> &upper,
+               const double              tolerance) const;
+
     /// "x-", "y+", ... for face f.
     static std::string
     face_name(const unsigned int face);

@@ -8,7 +8,9 @@
 #include <hysteron/base/checkpoint.h>
 #include <hysteron/scene/point_data.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -50,7 +52,9 @@ namespace hysteron
        * (kinetic, strain energy, internal, external and boundary work) and
        * @p reactions (one per column pair of reactions.csv). The arrays are
        * summed in place. A second row at the time of the last one is not written
-       * (every rank skips it, before the reduction).
+       * (every rank skips it, before the reduction). A NaN or infinite value is
+       * never written: every rank throws RuntimeError naming the table, the column
+       * and the time (the tables keep every row before).
        */
       void
       write(const double                         t,
@@ -75,6 +79,14 @@ namespace hysteron
       std::unique_ptr<Output::TimeTable>              energy_table, reaction_table;
       EnergyLog                                       energy_log;
       unsigned int                                    n_values = 0;
+      std::vector<std::string>                        point_names, reaction_names;
+
+      /// Throw RuntimeError if a value of @p row (of @p table, columns @p names) is not finite.
+      static void
+      check_finite(const double                     t,
+                   const std::vector<double>       &row,
+                   const std::string               &table,
+                   const std::vector<std::string>  &names);
       /// The time of the last row (a failing run writes its last good state, which
       /// may be the row just written: it is not repeated).
       double last_time   = 0;
@@ -114,8 +126,14 @@ namespace hysteron
       due(const double t, const bool last)
       {
         const bool now = interval == 0 || t >= next - eps || last;
-        while (interval > 0 && next <= t + eps)
-          next += interval;
+        // The next multiple of the interval after t: by steps of the interval (the
+        // times every earlier version wrote), or at once when a step spans more than
+        // a thousand intervals (an interval of 1e-300 s must not loop for ever).
+        for (unsigned int k = 0; interval > 0 && next <= t + eps; ++k)
+          if (k < 1000)
+            next += interval;
+          else
+            next = std::max(std::nextafter(t + eps, 1e300), (std::floor((t + eps) / interval) + 1) * interval);
         return now;
       }
 
