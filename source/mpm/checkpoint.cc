@@ -1,7 +1,7 @@
 // The MPM's part of a checkpoint: this rank's material points, bit for bit and in
 // the order of the arrays (the order of the sums of every step), and the sums
 // that a step carries over (works, reactions, the cell changes since the last sort).
-#include <hysteron/mpm/mpm.h>
+#include "mpm/mpm.h"
 
 #include <algorithm>
 

@@ -2,7 +2,7 @@
 // nodal velocities they set (with the reactions and the boundary work).
 #include <deal.II/base/mpi.h>
 
-#include <hysteron/mpm/mpm.h>
+#include "mpm/mpm.h"
 
 #include <algorithm>
 #include <iostream>

@@ -3,7 +3,7 @@
 #include <deal.II/grid/grid_generator.h>
 
 #include <hysteron/base/exceptions.h>
-#include <hysteron/mpm/grid.h>
+#include "mpm/grid.h"
 
 #include <algorithm>
 #include <climits>

@@ -6,7 +6,7 @@
 #include <hysteron/base/energy_check.h>
 #include <hysteron/base/exceptions.h>
 #include <hysteron/base/parameters.h>
-#include <hysteron/mpm/mpm.h>
+#include "mpm/mpm.h"
 
 #include <algorithm>
 #include <cmath>
@@ -83,10 +83,11 @@ namespace hysteron
                           "completeness hold; needs >= 3 cells per direction).");
         prm.declare_entry("Scheme",
                           "MUSL",
-                          Patterns::Selection("MUSL|USL|USF"),
-                          "When the stress is updated: MUSL (after the points, from remapped "
-                          "nodal velocities; dissertation §4.2), USL (after, from the updated "
-                          "nodal velocities) or USF (first, from the step's initial velocities).");
+                          Patterns::Selection(SchemeRegistry<3>::pattern_string()),
+                          "The update scheme: the order of the phases of a step, i.e. when and "
+                          "from which nodal velocities the stress is updated. Registered:" +
+                            SchemeRegistry<3>::documentation());
+        SchemeRegistry<3>::declare_parameters(prm);
         prm.declare_entry("FLIP fraction",
                           "1",
                           Patterns::Double(),
@@ -160,8 +161,7 @@ namespace hysteron
                       std::to_string(CubicBSpline1D::minimum_cells()) +
                       " cells per direction; the grid has " + std::to_string(n_cells[d]) +
                       " in " + component_suffix[d]);
-        const std::string sc = s.get("Scheme");
-        scheme = sc == "MUSL" ? Scheme::musl : sc == "USL" ? Scheme::usl : Scheme::usf;
+        update_scheme = SchemeRegistry<dim>::create(s.get("Scheme"), s.where("Scheme"));
         flip_fraction = s.get_non_negative("FLIP fraction");
         require(flip_fraction <= 1.0, s.where("FLIP fraction"), "must be in [0, 1] (got " + s.get("FLIP fraction") + ")");
         jaumann        = s.get("Stress rate") == "Jaumann";
@@ -321,9 +321,9 @@ namespace hysteron
         m_min = std::min(m_min, m);
       m_min      = dealii::Utilities::MPI::min(m_min, scene.mpi_communicator());
       small_mass = 1e-12 * m_min;
-      // The basis is chosen once: the step kernel is a template of it.
-      step_kernel = basis_name == "linear" ? &Solver::template step<Linear1D> :
-                                             &Solver::template step<CubicBSpline1D>;
+      // The basis is chosen once: the phase kernels are templates of it.
+      phases = basis_name == "linear" ? make_step_phases<dim, Linear1D>(*this) :
+                                        make_step_phases<dim, CubicBSpline1D>(*this);
 
       scene.console() << "mpm: " << n_global_particles << " material points, grid of ";
       for (unsigned int d = 0; d < dim; ++d)
@@ -400,7 +400,8 @@ namespace hysteron
         reactions     = reactions_at_t;
         throw Run::StepFailure(what);
       };
-      (this->*step_kernel)(t, dt);
+      begin_step(t);
+      update_scheme->step(*phases, t, dt);
       bool failed = failed_point >= 0;
       if (grid->is_parallel())
         failed = dealii::Utilities::MPI::logical_or(failed, grid->mpi_communicator());

@@ -3,7 +3,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/particles/data_out.h>
 
-#include <hysteron/mpm/mpm.h>
+#include "mpm/mpm.h"
 
 #include <algorithm>
 

@@ -4,7 +4,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/utilities.h>
 
-#include <hysteron/mpm/mpm.h>
+#include "mpm/mpm.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,10 +1,11 @@
 #ifndef hysteron_source_mpm_step_h
 #define hysteron_source_mpm_step_h
 
-// The kernels of one MPM step, templates of the 1D basis kernel. Included only
-// by source/mpm/step_*.cc, which instantiate Solver<dim>::step<Basis>.
+// The phase kernels of one MPM step, templates of the 1D basis kernel, and the
+// StepPhases implementation that the update schemes call. Included only by
+// source/mpm/step_*.cc, which instantiate make_step_phases<dim, Basis>.
 
-#include <hysteron/mpm/mpm.h>
+#include "mpm/mpm.h"
 
 #include <cmath>
 #include <cstring>
@@ -83,59 +84,52 @@ namespace hysteron
             }
         }
       };
+
+      /// The lattice and the node strides the kernels need, read once per phase.
+      template <int dim>
+      struct GridGeometry
+      {
+        explicit GridGeometry(const BackgroundGrid<dim> &grid)
+          : lattice(grid.lattice())
+          , inv_h(1.0 / lattice.h)
+          , s1(grid.stride(1))
+          , s2(dim == 3 ? grid.stride(dim - 1) : 0)
+        {}
+
+        const Lattice<dim> &lattice;
+        const double        inv_h;
+        const unsigned int  s1, s2;
+      };
     } // namespace internal
 
 
 
     template <int dim>
-    template <typename Basis>
+    template <typename Basis, bool with_forces>
     void
-    Solver<dim>::step(const double t, const double dt)
+    Solver<dim>::particles_to_grid()
     {
       using namespace dealii;
       using Support = internal::Support<dim, Basis>;
 
-      const Lattice<dim> &lattice = grid->lattice();
-      const double        inv_h   = 1.0 / lattice.h;
-      const unsigned int  s1      = grid->stride(1);
-      const unsigned int  s2      = dim == 3 ? grid->stride(dim - 1) : 0;
-      constexpr unsigned int C    = 1 + 2 * dim; // mass, momentum / velocity, force / velocity change
-      double *const       node    = grid->data().data();
-      auto               &cur     = particles.current;
-      auto               &nxt     = particles.next;
-      const Tensor<1, dim> gravity = this->get_scene().gravity();
-      const double         tiny    = small_mass;
+      const internal::GridGeometry<dim> g(*grid);
+      constexpr unsigned int C       = 1 + 2 * dim;
+      double *const          node    = grid->data().data();
+      const auto            &cur     = particles.current;
+      const Tensor<1, dim>   gravity = this->get_scene().gravity();
 
-      // Reset the nodes touched in the previous step (and the shared ones).
-      for (const unsigned int n : active_nodes)
-        std::memset(node + std::size_t(n) * C, 0, C * sizeof(double));
-      grid->zero_interface(0, C);
-      for (const unsigned int n : rigid_nodes)
-        rigid_node_body[n] = 0;
-      active_nodes.clear();
-      rigid_nodes.clear();
-      ++stamp;
-      for (auto &r : reactions)
-        r = Tensor<1, dim>();
-      failed_point = -1;
-      failure.clear();
-
-      for (unsigned int l = 1; l < load_per_point.size(); ++l)
-        load_per_point[l] = this->get_scene().load_descriptions()[l - 1].value_at(t);
-
-      // 1. P2G: mass, momentum and (except USF) forces.
-      const bool forces_now = scheme != Scheme::usf;
       for (const auto &group : particles.groups)
         {
           unsigned int last_cell = numbers::invalid_unsigned_int;
           Support      support;
           for (unsigned int p = group.begin; p < group.end; ++p)
             {
-              support.reinit(lattice, *grid, cur.x[p], inv_h);
+              support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
+              // The nodes of a cell are listed once per step (the first point of the cell).
               if (particles.cell[p] != last_cell)
                 {
                   last_cell = particles.cell[p];
-                  support.for_each(s1, s2, [&](const unsigned int n, double, const Tensor<1, dim> &) {
+                  support.for_each(g.s1, g.s2, [&](const unsigned int n, double, const Tensor<1, dim> &) {
                     if (node_stamp[n] != stamp)
                       {
                         node_stamp[n] = stamp;
@@ -152,13 +146,14 @@ namespace hysteron
                 continue;
               const double         m  = particles.mass[p];
               const Tensor<1, dim> mv = m * cur.v[p];
-              if (forces_now)
+              if constexpr (with_forces)
                 {
+                  // f_i += N_ip (m_p g + f_p) - V_p sigma_p grad N_ip
                   const Tensor<1, dim> f_ext =
                     m * gravity + particles.load_factor[p] * load_per_point[particles.load[p]];
                   const SymmetricTensor<2, dim> vs = cur.volume[p] * cur.stress[p];
-                  support.for_each(s1, s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
-                    double *const       r = node + std::size_t(n) * C;
+                  support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
+                    double *const        r = node + std::size_t(n) * C;
                     const Tensor<1, dim> f = N * f_ext - vs * grad;
                     r[0] += N * m;
                     for (unsigned int d = 0; d < dim; ++d)
@@ -169,7 +164,7 @@ namespace hysteron
                   });
                 }
               else
-                support.for_each(s1, s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &) {
+                support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &) {
                   double *const r = node + std::size_t(n) * C;
                   r[0] += N * m;
                   for (unsigned int d = 0; d < dim; ++d)
@@ -177,74 +172,67 @@ namespace hysteron
                 });
             }
         }
-      grid->exchange(0, forces_now ? C : 1 + dim);
+      grid->exchange(0, with_forces ? C : 1 + dim);
+      nodes_hold_momenta = true;
+    }
 
-      // 2. Nodal velocities and their change over the step.
-      if (scheme == Scheme::usf)
-        {
-          for (const unsigned int n : active_nodes)
-            {
-              double *const r = node + std::size_t(n) * C;
-              const double  inv_m = r[0] > tiny ? 1.0 / r[0] : 0.0;
-              for (unsigned int d = 0; d < dim; ++d)
-                r[1 + d] *= inv_m;
-            }
-          apply_boundary_conditions(t, dt, false);
-          update_stresses<Basis>(dt);
-          if (failed_point >= 0)
-            return;
-          // Forces from the updated stresses.
-          for (const auto &group : particles.groups)
-            if (group.material != nullptr)
-              {
-                Support support;
-                for (unsigned int p = group.begin; p < group.end; ++p)
-                  {
-                    support.reinit(lattice, *grid, cur.x[p], inv_h);
-                    const Tensor<1, dim> f_ext =
-                      particles.mass[p] * gravity +
-                      particles.load_factor[p] * load_per_point[particles.load[p]];
-                    const SymmetricTensor<2, dim> vs = nxt.volume[p] * nxt.stress[p];
-                    support.for_each(s1, s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
-                      double *const        r = node + std::size_t(n) * C;
-                      const Tensor<1, dim> f = N * f_ext - vs * grad;
-                      for (unsigned int d = 0; d < dim; ++d)
-                        r[1 + dim + d] += f[d];
-                    });
-                  }
-              }
-          grid->exchange(1 + dim, dim);
-          for (const unsigned int n : active_nodes)
-            {
-              double *const r = node + std::size_t(n) * C;
-              const double  dt_m = r[0] > tiny ? dt / r[0] : 0.0;
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  r[1 + dim + d] *= dt_m;       // velocity change
-                  r[1 + d] += r[1 + dim + d];   // new velocity
-                }
-            }
-        }
-      else
-        for (const unsigned int n : active_nodes)
+
+
+    template <int dim>
+    template <typename Basis>
+    void
+    Solver<dim>::forces_to_grid(const bool updated_stresses)
+    {
+      using namespace dealii;
+      using Support = internal::Support<dim, Basis>;
+
+      const internal::GridGeometry<dim> g(*grid);
+      constexpr unsigned int C       = 1 + 2 * dim;
+      double *const          node    = grid->data().data();
+      const auto            &cur     = particles.current;
+      const auto            &state   = updated_stresses ? particles.next : particles.current;
+      const Tensor<1, dim>   gravity = this->get_scene().gravity();
+
+      for (const auto &group : particles.groups)
+        if (group.material != nullptr)
           {
-            double *const r = node + std::size_t(n) * C;
-            if (r[0] > tiny)
+            Support support;
+            for (unsigned int p = group.begin; p < group.end; ++p)
               {
-                const double inv_m = 1.0 / r[0];
-                for (unsigned int d = 0; d < dim; ++d)
-                  {
-                    r[1 + dim + d] *= dt * inv_m;                    // velocity change
-                    r[1 + d] = r[1 + d] * inv_m + r[1 + dim + d];    // new velocity
-                  }
+                support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
+                const Tensor<1, dim> f_ext =
+                  particles.mass[p] * gravity +
+                  particles.load_factor[p] * load_per_point[particles.load[p]];
+                const SymmetricTensor<2, dim> vs = state.volume[p] * state.stress[p];
+                support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
+                  double *const        r = node + std::size_t(n) * C;
+                  const Tensor<1, dim> f = N * f_ext - vs * grad;
+                  for (unsigned int d = 0; d < dim; ++d)
+                    r[1 + dim + d] += f[d];
+                });
               }
-            else
-              for (unsigned int c = 1; c < C; ++c)
-                r[c] = 0.0;
           }
-      apply_boundary_conditions(t + dt, dt, true);
+      grid->exchange(1 + dim, dim);
+    }
 
-      // 3. G2P: velocities (FLIP/PIC blend) and positions.
+
+
+    template <int dim>
+    template <typename Basis>
+    bool
+    Solver<dim>::grid_to_particles(const double t, const double dt)
+    {
+      using namespace dealii;
+      using Support = internal::Support<dim, Basis>;
+
+      const internal::GridGeometry<dim> g(*grid);
+      constexpr unsigned int C       = 1 + 2 * dim;
+      const double *const    node    = grid->data().data();
+      const auto            &cur     = particles.current;
+      auto                  &nxt     = particles.next;
+      const Tensor<1, dim>   gravity = this->get_scene().gravity();
+
+      // Velocities (FLIP/PIC blend) and positions.
       const double alpha = flip_fraction;
       max_speed          = 0;
       kinetic_energy     = 0;
@@ -271,9 +259,9 @@ namespace hysteron
           Support support;
           for (unsigned int p = group.begin; p < group.end; ++p)
             {
-              support.reinit(lattice, *grid, cur.x[p], inv_h);
+              support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
               Tensor<1, dim> v_pic, dv;
-              support.for_each(s1, s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &) {
+              support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &) {
                 const double *const r = node + std::size_t(n) * C;
                 for (unsigned int d = 0; d < dim; ++d)
                   {
@@ -302,45 +290,7 @@ namespace hysteron
               failed_point = p;
               failure      = "a non-finite velocity";
             }
-      if (failed_point >= 0)
-        return;
-
-      // 4. MUSL: nodal velocities from the updated point momenta.
-      if (scheme == Scheme::musl)
-        {
-          for (const unsigned int n : active_nodes)
-            for (unsigned int d = 0; d < dim; ++d)
-              node[std::size_t(n) * C + 1 + d] = 0.0;
-          grid->zero_interface(1, dim);
-          for (const auto &group : particles.groups)
-            if (group.material != nullptr)
-              {
-                Support support;
-                for (unsigned int p = group.begin; p < group.end; ++p)
-                  {
-                    support.reinit(lattice, *grid, cur.x[p], inv_h);
-                    const Tensor<1, dim> mv = particles.mass[p] * nxt.v[p];
-                    support.for_each(s1, s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &) {
-                      double *const r = node + std::size_t(n) * C;
-                      for (unsigned int d = 0; d < dim; ++d)
-                        r[1 + d] += N * mv[d];
-                    });
-                  }
-              }
-          grid->exchange(1, dim);
-          for (const unsigned int n : active_nodes)
-            {
-              double *const r     = node + std::size_t(n) * C;
-              const double  inv_m = r[0] > tiny ? 1.0 / r[0] : 0.0;
-              for (unsigned int d = 0; d < dim; ++d)
-                r[1 + d] *= inv_m;
-            }
-          apply_boundary_conditions(t + dt, dt, false);
-        }
-
-      // 5. Strains and stresses (USF did this before the forces).
-      if (scheme != Scheme::usf)
-        update_stresses<Basis>(dt);
+      return failed_point < 0;
     }
 
 
@@ -348,15 +298,52 @@ namespace hysteron
     template <int dim>
     template <typename Basis>
     void
-    Solver<dim>::update_stresses(const double dt)
+    Solver<dim>::remap_momenta()
     {
       using namespace dealii;
       using Support = internal::Support<dim, Basis>;
 
-      const Lattice<dim> &lattice = grid->lattice();
-      const double        inv_h   = 1.0 / lattice.h;
-      const unsigned int  s1      = grid->stride(1);
-      const unsigned int  s2      = dim == 3 ? grid->stride(dim - 1) : 0;
+      const internal::GridGeometry<dim> g(*grid);
+      constexpr unsigned int C    = 1 + 2 * dim;
+      double *const          node = grid->data().data();
+      const auto            &cur  = particles.current;
+      const auto            &nxt  = particles.next;
+
+      // p_i = sum_p N_ip m_p v_p' (the masses m_i are those of the step's start).
+      for (const unsigned int n : active_nodes)
+        for (unsigned int d = 0; d < dim; ++d)
+          node[std::size_t(n) * C + 1 + d] = 0.0;
+      grid->zero_interface(1, dim);
+      for (const auto &group : particles.groups)
+        if (group.material != nullptr)
+          {
+            Support support;
+            for (unsigned int p = group.begin; p < group.end; ++p)
+              {
+                support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
+                const Tensor<1, dim> mv = particles.mass[p] * nxt.v[p];
+                support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &) {
+                  double *const r = node + std::size_t(n) * C;
+                  for (unsigned int d = 0; d < dim; ++d)
+                    r[1 + d] += N * mv[d];
+                });
+              }
+          }
+      grid->exchange(1, dim);
+      nodes_hold_momenta = true;
+    }
+
+
+
+    template <int dim>
+    template <typename Basis, bool midpoint>
+    bool
+    Solver<dim>::update_stresses(const double dt, const bool record_work)
+    {
+      using namespace dealii;
+      using Support = internal::Support<dim, Basis>;
+
+      const internal::GridGeometry<dim> g(*grid);
       constexpr unsigned int C    = 1 + 2 * dim;
       const double *const node    = grid->data().data();
       auto               &cur     = particles.current;
@@ -385,13 +372,24 @@ namespace hysteron
               const unsigned int chunk_end = std::min(end, chunk + stress_chunk);
               for (unsigned int p = chunk; p < chunk_end; ++p)
                 {
-                  support.reinit(lattice, *grid, cur.x[p], inv_h);
+                  support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
                   Tensor<2, dim> L; // velocity gradient sum_i v_i (x) grad N_i
-                  support.for_each(s1, s2, [&](const unsigned int n, double, const Tensor<1, dim> &grad) {
+                  support.for_each(g.s1, g.s2, [&](const unsigned int n, double, const Tensor<1, dim> &grad) {
                     const double *const r = node + std::size_t(n) * C;
-                    for (unsigned int i = 0; i < dim; ++i)
-                      for (unsigned int j = 0; j < dim; ++j)
-                        L[i][j] += r[1 + i] * grad[j];
+                    if constexpr (midpoint)
+                      {
+                        // v_i - Delta v_i / 2 = (v_i(t) + v_i(t + dt)) / 2
+                        for (unsigned int i = 0; i < dim; ++i)
+                          {
+                            const double v = r[1 + i] - 0.5 * r[1 + dim + i];
+                            for (unsigned int j = 0; j < dim; ++j)
+                              L[i][j] += v * grad[j];
+                          }
+                      }
+                    else
+                      for (unsigned int i = 0; i < dim; ++i)
+                        for (unsigned int j = 0; j < dim; ++j)
+                          L[i][j] += r[1 + i] * grad[j];
                   });
                   const SymmetricTensor<2, dim> de = symmetrize(L) * dt;
                   strain_increment[p - chunk]      = de;
@@ -433,11 +431,100 @@ namespace hysteron
                         failed_point = p;
                         failure      = "a non-finite stress";
                       }
-                  return;
+                  return failed_point < 0;
                 }
-              internal_work += work;
+              if (record_work)
+                internal_work += work;
             }
         }
+      return true;
+    }
+
+
+
+    /**
+     * The phases of the step with the basis @p Basis, for the update schemes:
+     * each virtual function calls the solver's kernel of this basis (the
+     * choice between kernels is one branch per phase and step).
+     */
+    template <int dim, typename Basis>
+    class PhaseKernels : public StepPhases<dim>
+    {
+    public:
+      explicit PhaseKernels(Solver<dim> &solver)
+        : solver(solver)
+      {}
+
+      void
+      particles_to_grid(const bool forces) override
+      {
+        if (forces)
+          solver.template particles_to_grid<Basis, true>();
+        else
+          solver.template particles_to_grid<Basis, false>();
+      }
+
+      void
+      forces_to_grid(const typename StepPhases<dim>::Stress stress) override
+      {
+        solver.template forces_to_grid<Basis>(stress == StepPhases<dim>::Stress::updated);
+      }
+
+      void
+      nodal_velocities() override
+      {
+        solver.nodal_velocities();
+      }
+
+      void
+      update_nodal_velocities(const double dt) override
+      {
+        solver.update_nodal_velocities(dt);
+      }
+
+      void
+      boundary_conditions(const double t, const double dt, const bool record) override
+      {
+        solver.apply_boundary_conditions(t, dt, record);
+      }
+
+      bool
+      grid_to_particles(const double t, const double dt) override
+      {
+        return solver.template grid_to_particles<Basis>(t, dt);
+      }
+
+      void
+      remap_momenta() override
+      {
+        solver.template remap_momenta<Basis>();
+      }
+
+      bool
+      update_stresses(const double dt, const typename StepPhases<dim>::Velocity velocity) override
+      {
+        return velocity == StepPhases<dim>::Velocity::midpoint ?
+                 solver.template update_stresses<Basis, true>(dt, true) :
+                 solver.template update_stresses<Basis, false>(dt, true);
+      }
+
+      bool
+      predict_stresses(const double dt) override
+      {
+        return solver.template update_stresses<Basis, false>(dt, false);
+      }
+
+    private:
+      Solver<dim> &solver;
+    };
+
+
+
+    template <int dim, typename Basis>
+    std::unique_ptr<StepPhases<dim>>
+    make_step_phases(Solver<dim> &solver)
+    {
+      return std::make_unique<PhaseKernels<dim, Basis>>(solver);
     }
   } // namespace MPM
 } // namespace hysteron

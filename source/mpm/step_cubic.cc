@@ -5,7 +5,7 @@ namespace hysteron
 {
   namespace MPM
   {
-    template void Solver<2>::step<CubicBSpline1D>(double, double);
-    template void Solver<3>::step<CubicBSpline1D>(double, double);
+    template std::unique_ptr<StepPhases<2>> make_step_phases<2, CubicBSpline1D>(Solver<2> &);
+    template std::unique_ptr<StepPhases<3>> make_step_phases<3, CubicBSpline1D>(Solver<3> &);
   } // namespace MPM
 } // namespace hysteron

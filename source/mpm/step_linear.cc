@@ -5,7 +5,7 @@ namespace hysteron
 {
   namespace MPM
   {
-    template void Solver<2>::step<Linear1D>(double, double);
-    template void Solver<3>::step<Linear1D>(double, double);
+    template std::unique_ptr<StepPhases<2>> make_step_phases<2, Linear1D>(Solver<2> &);
+    template std::unique_ptr<StepPhases<3>> make_step_phases<3, Linear1D>(Solver<3> &);
   } // namespace MPM
 } // namespace hysteron

@@ -1,9 +1,9 @@
-// Unit tests of the MPM background-grid bases (hysteron/mpm/basis.h): partition
+// Unit tests of the MPM background-grid bases (source/mpm/basis.h): partition
 // of unity and linear completeness of the linear and boundary-modified cubic
 // B-spline kernels in 1D and as 2D/3D tensor products, analytic values,
 // derivatives against finite differences, C1 continuity of the cubic basis
 // across cell faces, nonnegativity, node ranges and the upper boundary.
-#include <hysteron/mpm/basis.h>
+#include "mpm/basis.h"
 
 #include <gtest/gtest.h>
 

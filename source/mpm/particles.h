@@ -1,5 +1,5 @@
-#ifndef hysteron_mpm_particles_h
-#define hysteron_mpm_particles_h
+#ifndef hysteron_source_mpm_particles_h
+#define hysteron_source_mpm_particles_h
 
 #include <deal.II/base/data_out_base.h>
 #include <deal.II/base/symmetric_tensor.h>

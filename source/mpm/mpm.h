@@ -1,17 +1,19 @@
-#ifndef hysteron_mpm_mpm_h
-#define hysteron_mpm_mpm_h
+#ifndef hysteron_source_mpm_mpm_h
+#define hysteron_source_mpm_mpm_h
 
 #include <deal.II/fe/mapping_cartesian.h>
 #include <deal.II/particles/particle_handler.h>
 
 #include <hysteron/base/output.h>
 #include <hysteron/geometry/region.h>
-#include <hysteron/mpm/grid.h>
-#include <hysteron/mpm/particles.h>
+#include <hysteron/mpm/update_scheme.h>
 #include <hysteron/run/stepping_method.h>
 #include <hysteron/scene/point_data.h>
 #include <hysteron/scene/tables.h>
 #include <hysteron/scene/scene.h>
+
+#include "mpm/grid.h"
+#include "mpm/particles.h"
 
 #include <cmath>
 #include <memory>
@@ -22,13 +24,8 @@ namespace hysteron
 {
   namespace MPM
   {
-    /// When the stress is updated in a step (dissertation §4.4).
-    enum class Scheme
-    {
-      musl, ///< modified update stress last: nodal velocities remapped from the updated points
-      usl,  ///< update stress last, from the updated nodal velocities
-      usf   ///< update stress first, from the nodal velocities of the step's start
-    };
+    template <int dim, typename Basis>
+    class PhaseKernels;
 
     /**
      * The explicit Material Point Method (`set Method = mpm`), dissertation
@@ -49,8 +46,11 @@ namespace hysteron
      * USL takes v_i' in step 5 without the remap; USF updates the stress with
      * the velocities p_i / m_i of step 1 before the forces are computed.
      *
-     * The kernels are templates of the basis (linear, cubic B-spline): the
-     * basis is chosen once, at set-up, and the scheme once per step.
+     * Each of these passes is a phase (StepPhases, update_scheme.h); the update
+     * scheme (`MPM/Scheme`, a registered UpdateScheme: source/mpm/schemes/)
+     * calls them in its order. The phase kernels are templates of the basis
+     * (linear, cubic B-spline, step.h); basis and scheme are chosen once, at
+     * set-up.
      *
      * The run loop (time steps, outputs, checkpoints, signals) is the driver's
      * (Run::SteppingMethod); this class implements the set-up, the step, the
@@ -77,11 +77,6 @@ namespace hysteron
       {
         return "";
       }
-
-      /// One step from t to t + dt with the basis @p Basis (a 1D kernel of basis.h).
-      template <typename Basis>
-      void
-      step(const double t, const double dt);
 
     protected:
       void
@@ -149,7 +144,6 @@ namespace hysteron
       double                        cell_size = 0;
       std::array<unsigned int, dim> n_cells;
       std::string                   basis_name;
-      Scheme                        scheme = Scheme::musl;
       double                        flip_fraction = 1.0;
       bool                          jaumann       = false;
       double                        maximum_cfl   = 1.0;
@@ -205,10 +199,34 @@ namespace hysteron
       bool
       needs_migration() const;
 
-      /// Strains, deformation gradients, volumes and stresses from the nodal velocities.
+      // The phases of a step (StepPhases documents what each computes).
+      template <int, typename>
+      friend class PhaseKernels;
+      /// Reset the nodes touched in the last step, the reactions and the loads at @p t.
+      void
+      begin_step(const double t);
+      template <typename Basis, bool with_forces>
+      void
+      particles_to_grid();
       template <typename Basis>
       void
-      update_stresses(const double dt);
+      forces_to_grid(const bool updated_stresses);
+      void
+      nodal_velocities();
+      void
+      update_nodal_velocities(const double dt);
+      template <typename Basis>
+      bool
+      grid_to_particles(const double t, const double dt);
+      template <typename Basis>
+      void
+      remap_momenta();
+      /// Strains, deformation gradients, volumes and stresses from the nodal
+      /// velocities (with @p midpoint from v_i - Delta v_i / 2), with or without
+      /// adding their work to internal_work.
+      template <typename Basis, bool midpoint>
+      bool
+      update_stresses(const double dt, const bool record_work);
 
       /// Record the cell of point p at its new position @p x (or the failure).
       void
@@ -276,8 +294,11 @@ namespace hysteron
       bool         left_subdomain       = false;
 
       // Bookkeeping.
-      /// The step kernel of the chosen basis (step<Linear1D> or step<CubicBSpline1D>).
-      void (Solver::*step_kernel)(double, double) = nullptr;
+      /// The update scheme (`MPM/Scheme`) and the phases of the chosen basis it calls.
+      std::unique_ptr<UpdateScheme<dim>> update_scheme;
+      std::unique_ptr<StepPhases<dim>>   phases;
+      /// Whether the nodes hold momenta p_i (after a transfer) or velocities v_i.
+      bool nodes_hold_momenta = true;
       unsigned int                                  n_rebuilds = 0;
       PointData::Tables<dim>                        tables;
       std::vector<std::string>                      state_names;
@@ -289,6 +310,13 @@ namespace hysteron
       std::vector<unsigned long>                    load_count; ///< points per load (index 0: none)
       dealii::types::particle_index                 n_global_particles = 0;
     };
+
+
+
+    /// The phases of the step with the basis @p Basis (instantiated in step_linear.cc, step_cubic.cc).
+    template <int dim, typename Basis>
+    std::unique_ptr<StepPhases<dim>>
+    make_step_phases(Solver<dim> &solver);
   } // namespace MPM
 } // namespace hysteron
 

@@ -1,5 +1,5 @@
-#ifndef hysteron_mpm_basis_h
-#define hysteron_mpm_basis_h
+#ifndef hysteron_source_mpm_basis_h
+#define hysteron_source_mpm_basis_h
 
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/point.h>

@@ -1,5 +1,5 @@
-#ifndef hysteron_mpm_grid_h
-#define hysteron_mpm_grid_h
+#ifndef hysteron_source_mpm_grid_h
+#define hysteron_source_mpm_grid_h
 
 #include <deal.II/base/index_set.h>
 #include <deal.II/base/mpi.h>
@@ -8,7 +8,7 @@
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/lac/la_parallel_vector.h>
 
-#include <hysteron/mpm/basis.h>
+#include "mpm/basis.h"
 
 #include <array>
 #include <memory>
