@@ -26,10 +26,9 @@ namespace hysteron
           out.put(sp.force);
           out.put(sp.trial_delta);
           out.put(sp.trial_force);
-          out.put(sp.tangent);
           out.put(sp.state);
           out.put(sp.trial_state);
-          out.put(sp.tangent_matrix);
+          out.put(sp.tangent);
           out.put(sp.broken);
         }
       out.section("rbsn sums");
@@ -74,10 +73,14 @@ namespace hysteron
           in.get(sp.force);
           in.get(sp.trial_delta);
           in.get(sp.trial_force);
-          in.get(sp.tangent);
+          // The spring law's state: as many doubles per facet as this run's law keeps.
+          const std::size_t n_state = sp.state.size();
           in.get(sp.state);
           in.get(sp.trial_state);
-          in.get(sp.tangent_matrix);
+          if (sp.state.size() != n_state || sp.trial_state.size() != n_state)
+            in.refuse("the facets' spring states differ from the checkpoint's (another "
+                      "RBSN/Spring law or Analysis)");
+          in.get(sp.tangent);
           in.get(sp.broken);
         }
       in.section("rbsn sums");
