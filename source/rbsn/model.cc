@@ -85,9 +85,10 @@ namespace hysteron
         prm.declare_entry("Spring law",
                           "uncoupled",
                           Patterns::Selection(SpringLawRegistry::pattern_string()),
-                          "The law of the facet springs between cells of Bouc-Wen bodies (a "
-                          "registered spring law, see doc/rbsn.md; linear-elastic bodies and "
-                          "Analysis = static have linear springs):" +
+                          "The law of the facet springs, a registered plugin (doc/rbsn.md; plugins "
+                          "from Additional shared libraries too). The built-in laws take the facets "
+                          "between Bouc-Wen cells (linear-elastic ones have linear springs); "
+                          "Analysis = static has linear springs throughout:" +
                             SpringLawRegistry::documentation());
         SpringLawRegistry::declare_parameters(prm);
         prm.declare_entry("Analysis",
