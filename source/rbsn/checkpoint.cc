@@ -18,7 +18,7 @@ namespace hysteron
       for (const Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia,
                               &reaction_old})
         put_vector(*x);
-      out.section("rbsn springs");
+      out.section("rbsn spring laws");
       out.put<std::uint64_t>(springs.size());
       for (const auto &sp : springs)
         {
@@ -64,7 +64,7 @@ namespace hysteron
                   "parameters and Random seed give the same network)");
       for (Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
         get_vector(*x);
-      in.section("rbsn springs");
+      in.section("rbsn spring laws");
       if (in.get<std::uint64_t>() != springs.size())
         in.refuse("the network has another number of facets than the checkpoint's");
       for (auto &sp : springs)
