@@ -1,19 +1,5 @@
 #!/usr/bin/env bash
-# ctest: install hysteron, build doc/examples/custom_material against the installed package,
-# and run its scene with the installed executable; the scene's CHECK lines must hold.
+# ctest: the user material doc/examples/custom_material built against the installed package
+# and its scene run (see extension_example.sh).
 # Usage: custom_material_example.sh <source dir> <build dir> <work dir>
-set -euo pipefail
-src=$1 build=$2 work=$3
-rm -rf "$work" && mkdir -p "$work"
-cmake --install "$build" --prefix "$work/install" > "$work/install.log"
-cp -r "$src/doc/examples/custom_material" "$work/example"
-cd "$work/example"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -Dhysteron_DIR="$work/install/lib/cmake/hysteron" > configure.log
-cmake --build build > build.log 2>&1 || { cat build.log; exit 1; }
-if grep -q 'warning:' build.log; then cat build.log; echo "the example builds with warnings"; exit 1; fi
-# The scene names the plugin relative to the example directory; the runner works elsewhere.
-sed "s|./build/libcustom_material.so|$work/example/build/libcustom_material.so|" damage.prm \
-  > damage_test.prm
-python3 "$src/tests/run_prm_test.py" --hysteron "$work/install/bin/hysteron" \
-  --workdir "$work/run" damage_test.prm
+exec "$(dirname "$0")/extension_example.sh" "$1" "$2" "$3" custom_material damage.prm

@@ -18,7 +18,7 @@ namespace hysteron
       for (const Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia,
                               &reaction_old})
         put_vector(*x);
-      out.section("rbsn springs");
+      out.section("rbsn spring laws");
       out.put<std::uint64_t>(springs.size());
       for (const auto &sp : springs)
         {
@@ -26,10 +26,9 @@ namespace hysteron
           out.put(sp.force);
           out.put(sp.trial_delta);
           out.put(sp.trial_force);
-          out.put(sp.tangent);
           out.put(sp.state);
           out.put(sp.trial_state);
-          out.put(sp.tangent_matrix);
+          out.put(sp.tangent);
           out.put(sp.broken);
         }
       out.section("rbsn sums");
@@ -65,7 +64,7 @@ namespace hysteron
                   "parameters and Random seed give the same network)");
       for (Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
         get_vector(*x);
-      in.section("rbsn springs");
+      in.section("rbsn spring laws");
       if (in.get<std::uint64_t>() != springs.size())
         in.refuse("the network has another number of facets than the checkpoint's");
       for (auto &sp : springs)
@@ -74,10 +73,14 @@ namespace hysteron
           in.get(sp.force);
           in.get(sp.trial_delta);
           in.get(sp.trial_force);
-          in.get(sp.tangent);
+          // The spring law's state: as many doubles per facet as this run's law keeps.
+          const std::size_t n_state = sp.state.size();
           in.get(sp.state);
           in.get(sp.trial_state);
-          in.get(sp.tangent_matrix);
+          if (sp.state.size() != n_state || sp.trial_state.size() != n_state)
+            in.refuse("the facets' spring states differ from the checkpoint's (another "
+                      "RBSN/Spring law or Analysis)");
+          in.get(sp.tangent);
           in.get(sp.broken);
         }
       in.section("rbsn sums");

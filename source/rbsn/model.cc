@@ -2,7 +2,6 @@
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 
 #include <hysteron/base/parameters.h>
-#include <hysteron/material/bouc_wen.h>
 #include <hysteron/rbsn/model.h>
 #include <hysteron/scene/output_column.h>
 #include <hysteron/rbsn/rbsn.h>
@@ -57,15 +56,13 @@ namespace hysteron
                           "springs yield at sigma_y t l and sigma_y t l / sqrt(3).");
         prm.declare_entry("Spring law",
                           "uncoupled",
-                          Patterns::Selection("uncoupled|coupled"),
-                          "The facet springs' Bouc-Wen law: 'uncoupled', three uniaxial laws "
-                          "(eq. 3.36), each yielding at its own F_y; 'coupled', one law for the "
-                          "three springs with the yield criterion (F^h_n / F^h_y,n)^2 + (F^h_t / "
-                          "F^h_y,t)^2 + (M^h / M^h_y)^2 <= 1 in the hysteretic forces F^h = (1 - a) "
-                          "k z and associated flow (eq. 3.38-3.42; F^h_y = (1 - a) F_y), a full 3 x "
-                          "3 facet tangent; it reduces to the uniaxial law when one component is "
-                          "loaded alone. No degradation with 'coupled'. See "
-                          "doc/rbsn_coupled_springs.md.");
+                          Patterns::Selection(SpringLawRegistry::pattern_string()),
+                          "The law of the facet springs, a registered plugin (doc/rbsn.md; plugins "
+                          "from Additional shared libraries too). The built-in laws take the facets "
+                          "between Bouc-Wen cells (linear-elastic ones have linear springs); "
+                          "Analysis = static has linear springs throughout:" +
+                            SpringLawRegistry::documentation());
+        SpringLawRegistry::declare_parameters(prm);
         prm.declare_entry("Analysis",
                           "quasi-static",
                           Patterns::Selection("static|quasi-static|implicit dynamics|variable order"),
@@ -139,7 +136,9 @@ namespace hysteron
           boundary_h = 0.25 * d_m;
         shear_ratio  = s.get_non_negative("Shear stiffness ratio");
         moment_yield = s.get_positive("Moment yield factor");
-        spring_law   = s.get("Spring law") == "coupled" ? SpringLaw::coupled : SpringLaw::uncoupled;
+        spring_law_name = s.get("Spring law");
+        spring_law      = SpringLawRegistry::create(spring_law_name, s.where("Spring law"));
+        spring_law->parse_parameters(s);
         const std::string type = s.get("Analysis");
         analysis = type == "static"            ? Analysis::linear_static :
                    type == "quasi-static"      ? Analysis::quasi_static :
@@ -177,18 +176,13 @@ namespace hysteron
             require(m.elasticity().stress_state != Material::StressState::three_dimensional,
                     "Body " + bodies[b].name + "/Material",
                     "the rbsn method is two-dimensional");
-            const bool bouc_wen = dynamic_cast<const Material::BoucWen<2> *>(&m) != nullptr;
-            require(bouc_wen || m.n_state_variables() == 0,
+            require(m.spring_behaviour().type != Material::SpringBehaviour::Type::none,
                     "Body " + bodies[b].name + "/Material",
                     "the rbsn method's springs follow the uniaxial Bouc-Wen law: the body's "
                     "material must be 'bouc-wen' or 'linear elastic'");
-            consistent_tangent = consistent_tangent && m.has_consistent_tangent();
-            if (bouc_wen && spring_law == SpringLaw::coupled)
-              {
-                const std::string why = Material::BoucWenInteraction::unsupported(
-                  dynamic_cast<const Material::BoucWen<2> &>(m).get_parameters());
-                require(why.empty(), "RBSN/Spring law", why + " (body " + bodies[b].name + ")");
-              }
+            consistent_tangent = consistent_tangent && spring_law->has_consistent_tangent(m);
+            const std::string why = spring_law->unsupported(m);
+            require(why.empty(), "RBSN/Spring law", why + " (body " + bodies[b].name + ")");
             require(bodies[b].initial_velocity == nullptr || dynamic(),
                     "Body " + bodies[b].name + "/Initial velocity",
                     "only dynamic analyses have velocities");
@@ -310,6 +304,11 @@ namespace hysteron
                                                f.h_b / mb.elasticity().shear_modulus());
           sp.k[2]      = sp.k[0] * l * l / 12;
           sp.thickness = t;
+          FacetSprings facet;
+          facet.k                   = sp.k;
+          facet.thickness           = t;
+          facet.length              = l;
+          facet.moment_yield_factor = moment_yield;
           // B (eq. 3.6, with the corrections in doc/theory.md): the displacement of P as a
           // point of cell b minus as a point of cell a, in the facet's (n, t) axes,
           // u_P = u_i - (y_P - y_i) theta_i, v_P = v_i + (x_P - x_i) theta_i.
@@ -322,31 +321,16 @@ namespace hysteron
           sp.B_n = {{-n[0], -n[1], -cross(ra, n), n[0], n[1], cross(rb, n)}};
           sp.B_t = {{-tt[0], -tt[1], -cross(ra, tt), tt[0], tt[1], cross(rb, tt)}};
 
-          // Bouc-Wen springs (uniaxial, eq. 3.32-3.36) when both cells are Bouc-Wen.
-          const auto *bwa = dynamic_cast<const Material::BoucWen<2> *>(&ma);
-          const auto *bwb = dynamic_cast<const Material::BoucWen<2> *>(&mb);
-          if (bwa && bwb && analysis != Analysis::linear_static)
+          // The spring law's springs (static: linear springs, the plasticity ignored).
+          if (analysis != Analysis::linear_static)
             {
-              const auto  &prm     = bwa->get_parameters();
-              const double sigma_y = std::min(prm.yield_stress, bwb->get_parameters().yield_stress);
-              sp.yield             = {{sigma_y * t * l, sigma_y * t * l / std::sqrt(3.0), moment_yield * sigma_y * t * l * l}};
-              for (unsigned int i = 0; i < 3; ++i)
-                {
-                  sp.law[i].reinit(prm, sp.k[i], sp.yield[i]);
-                  sp.law[i].initialize_state(sp.state.data() + 3 * i);
-                }
-              sp.hysteretic = true;
-              if (spring_law == SpringLaw::coupled)
-                {
-                  // One law for the three springs (eq. 3.38-3.42), z_i in the slots state[3 i].
-                  sp.coupled = true;
-                  sp.coupled_law.reinit(prm, sp.k, sp.yield);
-                  sp.coupled_law.initialize_state(sp.state.data(), 3);
-                }
+              sp.state.assign(spring_law->n_state_variables(), 0.0);
+              sp.hysteretic = spring_law->setup_facet(e, facet, ma, mb, sp.state.data());
+              if (!sp.hysteretic)
+                sp.state.clear();
             }
-          sp.tangent     = sp.k; // the first predictor's
           for (unsigned int i = 0; i < 3; ++i)
-            sp.tangent_matrix[i][i] = sp.k[i];
+            sp.tangent[i][i] = sp.k[i]; // the first predictor's
           sp.trial_state = sp.state;
         }
     }

@@ -40,7 +40,7 @@ namespace hysteron
       out[11] = sp.force[0] / area;
       out[12] = sp.force[1] / area;
       for (unsigned int i = 0; i < 3; ++i)
-        out[13 + i] = sp.h1(i); // the coupled law: Phi^n of the facet in all three
+        out[13 + i] = h1(e, i); // the coupled law: Phi^n of the facet in all three
       out[16] = sp.broken ? 1.0 : 0.0;
     }
 
@@ -160,17 +160,14 @@ namespace hysteron
           kinetic += 0.5 * (m * (vx * vx + vy * vy) + cell_inertia[c] * om * om) +
                      om * m * (-cell_offset[c][1] * vx + cell_offset[c][0] * vy);
         }
-      for (const auto &sp : springs)
-        if (!sp.broken)
+      for (unsigned int e = 0; e < springs.size(); ++e)
+        if (const Springs &sp = springs[e]; !sp.broken)
           for (unsigned int i = 0; i < 3; ++i)
             {
               if (!sp.hysteretic)
                 strain_energy += 0.5 * sp.k[i] * sp.delta[i] * sp.delta[i];
               else
-                {
-                  const double a = sp.law[i].parameters().post_yield_ratio, z = sp.state[3 * i];
-                  strain_energy += 0.5 * a * sp.k[i] * sp.delta[i] * sp.delta[i] + 0.5 * (1 - a) * sp.k[i] * z * z;
-                }
+                strain_energy += spring_law->strain_energy(e, i, sp.delta[i], sp.state.data());
             }
 
       // The reactions f_int + inertia - f_ext of the converged state (reaction_old, set by
@@ -211,7 +208,7 @@ namespace hysteron
       for (unsigned int e = 0; e < springs.size(); ++e)
         if (springs[e].hysteretic && !springs[e].broken)
           for (const unsigned int c : {network.facets[e].a, network.facets[e].b})
-            cell_h1[c] = std::max(cell_h1[c], springs[e].h1(0));
+            cell_h1[c] = std::max(cell_h1[c], this->h1(e, 0));
       for (unsigned int c = 0; c < network.cells.size(); ++c)
         for (const auto &loop : network.cells[c].outline)
           {
@@ -242,7 +239,7 @@ namespace hysteron
           facet_index.push_back(e);
           body.push_back(cell_body[f.a]);
           theta.push_back(0);
-          h1.push_back(std::max({sp.h1(0), sp.h1(1), sp.h1(2)}));
+          h1.push_back(std::max({this->h1(e, 0), this->h1(e, 1), this->h1(e, 2)}));
           const double area = sp.thickness * f.length;
           const double values[5] = {sp.force[0], sp.force[1], sp.force[2], sp.force[0] / area, sp.force[1] / area};
           for (unsigned int k = 0; k < 5; ++k)
@@ -324,7 +321,7 @@ namespace hysteron
                                   sp.k[2], sp.delta[0], sp.delta[1],
                                   sp.delta[2], sp.force[0], sp.force[1], sp.force[2]};
           for (unsigned int i = 0; i < 3; ++i)
-            row.push_back(sp.h1(i));
+            row.push_back(h1(e, i));
           row.push_back(sp.broken ? 1 : 0);
           out.add_row(row);
         }

@@ -15,10 +15,11 @@ namespace hysteron
     /*
      * The equations. For facet e between cells a and b with U_e = (u_a, v_a,
      * theta_a, u_b, v_b, theta_b), the springs' deformations are
-     * delta = (B_n U_e, B_t U_e, theta_b - theta_a) and their forces F_i(delta_i)
-     * (linear, or the uniaxial Bouc-Wen law from the converged state, eq. 3.32);
-     *   f_int = sum_e B^T F,   K = sum_e B^T diag(dF_i / d delta_i) B    (eq. 3.10, 3.31),
-     * or with the coupled law (eq. 3.38-3.42) K = sum_e B^T D_t B, D_t = dF / d delta (3 x 3).
+     * delta = (B_n U_e, B_t U_e, theta_b - theta_a) and their forces F(delta)
+     * (linear, or the spring law from the converged state, e.g. the uniaxial Bouc-Wen
+     * law, eq. 3.32, or the coupled law, eq. 3.38-3.42);
+     *   f_int = sum_e B^T F,   K = sum_e B^T D_t B,   D_t = dF / d delta (3 x 3)   (eq. 3.10, 3.31),
+     * with only the diagonal of D_t for linear springs and laws of independent springs.
      * Quasi-static: r = f_int(u) - f_ext(t). Dynamics (HHT-alpha, Newmark for
      * alpha = 0, as the FEM): with the cell mass matrices M_c of eq. 3.12 and
      * C = a0 M + a1 K0 (K0: the elastic springs),
@@ -41,6 +42,7 @@ namespace hysteron
       std::vector<dealii::types::global_dof_index> dofs(6);
       bool        failed = false;
       std::string message;
+      const bool  diagonal_law = spring_law->diagonal_tangent();
       for (unsigned int e = 0; e < springs.size(); ++e)
         {
           Springs &sp = springs[e];
@@ -55,59 +57,33 @@ namespace hysteron
           for (unsigned int k = 0; k < 6; ++k)
             ue[k] = u_trial(dofs[k]);
           const auto row = [&](const unsigned int i, const unsigned int k) { return sp.B(i, k); };
+          SpringLaw::Vector increment;
           for (unsigned int i = 0; i < 3; ++i)
             {
               sp.trial_delta[i] = sp.deformation(i, ue);
-              const double increment = sp.trial_delta[i] - sp.delta[i];
-              if (!update_springs)
+              increment[i]      = sp.trial_delta[i] - sp.delta[i];
+              if (!update_springs || sp.hysteretic)
+                sp.trial_force[i] = sp.force[i];
+              else
                 {
-                  sp.trial_force[i] = sp.force[i];
-                  continue;
-                }
-              if (!sp.hysteretic)
-                {
-                  sp.trial_force[i] = sp.k[i] * sp.trial_delta[i];
-                  sp.tangent[i]     = sp.k[i];
-                  continue;
-                }
-              if (sp.coupled)
-                continue; // the three springs together, below
-              sp.trial_force[i] = sp.force[i];
-              std::copy(sp.state.begin() + 3 * i, sp.state.begin() + 3 * i + 3, sp.trial_state.begin() + 3 * i);
-              try
-                {
-                  sp.law[i].update(increment, sp.trial_force[i], sp.trial_state.data() + 3 * i,
-                                   with_matrix ? &sp.tangent[i] : nullptr);
-                }
-              catch (const RuntimeError &error)
-                {
-                  failed = true;
-                  std::ostringstream m;
-                  m << error.what() << " (the " << (i == 0 ? "normal" : i == 1 ? "tangential" : "rotational")
-                    << " spring of the facet at " << f.midpoint << ", step to t = " << t1 << " s)";
-                  message = m.str();
+                  sp.trial_force[i]   = sp.k[i] * sp.trial_delta[i];
+                  sp.tangent[i][i] = sp.k[i];
                 }
             }
-          if (sp.coupled && update_springs)
+          if (update_springs && sp.hysteretic)
             {
-              // The coupled law (eq. 3.38-3.42): one update of the facet, a full 3 x 3 D_t.
-              Material::BoucWenInteraction::Vector increment;
-              for (unsigned int i = 0; i < 3; ++i)
-                {
-                  increment[i]          = sp.trial_delta[i] - sp.delta[i];
-                  sp.trial_force[i]     = sp.force[i];
-                  sp.trial_state[3 * i] = sp.state[3 * i];
-                }
+              // The spring law from the converged forces and state: one call per facet.
+              std::copy(sp.state.begin(), sp.state.end(), sp.trial_state.begin());
               try
                 {
-                  sp.coupled_law.update(increment, sp.trial_force, sp.trial_state.data(),
-                                        with_matrix ? &sp.tangent_matrix : nullptr, 3);
+                  spring_law->update(e, increment, sp.trial_force, sp.trial_state.data(),
+                                     with_matrix ? &sp.tangent : nullptr);
                 }
-              catch (const RuntimeError &error)
+              catch (const SpringFailure &error)
                 {
                   failed = true;
                   std::ostringstream m;
-                  m << error.what() << " (the coupled springs of the facet at " << f.midpoint
+                  m << error.what() << " (" << error.springs << " of the facet at " << f.midpoint
                     << ", step to t = " << t1 << " s)";
                   message = m.str();
                 }
@@ -120,13 +96,13 @@ namespace hysteron
               for (unsigned int i = 0; i < 3; ++i)
                 fe[k] += row(i, k) * sp.trial_force[i];
             }
-          if (with_matrix && !sp.coupled)
+          if (with_matrix && (diagonal_law || !sp.hysteretic))
             for (unsigned int p = 0; p < 6; ++p)
               for (unsigned int q = 0; q < 6; ++q)
                 {
                   K(p, q) = 0;
                   for (unsigned int i = 0; i < 3; ++i)
-                    K(p, q) += row(i, p) * sp.tangent[i] * row(i, q);
+                    K(p, q) += row(i, p) * sp.tangent[i][i] * row(i, q);
                 }
           else if (with_matrix)
             for (unsigned int p = 0; p < 6; ++p)
@@ -136,7 +112,7 @@ namespace hysteron
                   K(p, q) = 0;
                   for (unsigned int i = 0; i < 3; ++i)
                     for (unsigned int j = 0; j < 3; ++j)
-                      K(p, q) += row(i, p) * sp.tangent_matrix[i][j] * row(j, q);
+                      K(p, q) += row(i, p) * sp.tangent[i][j] * row(j, q);
                 }
           r = fe;
           if (dynamic)

@@ -114,9 +114,10 @@ namespace hysteron
                 "the variable-order analysis has no fracture (a break is a discontinuity of the "
                 "DAE that IDA integrates): use Analysis = implicit dynamics, or switch fracture off");
       if (analysis == Analysis::variable_order)
-        require(spring_law == SpringLaw::uncoupled, "RBSN/Spring law",
-                "the variable-order analysis integrates the uncoupled springs' rates; use "
-                "Analysis = implicit dynamics with the coupled law");
+        {
+          const std::string why = spring_law->variable_order_unsupported();
+          require(why.empty(), "RBSN/Spring law", why);
+        }
     }
 
 
@@ -158,12 +159,26 @@ namespace hysteron
       unsigned int n = 0, n_states = 0, n_total = 0;
       /// Per spring (index 3 e + i): the offset of its Bouc-Wen state within s, -1 if linear.
       std::vector<int>              state_offset;
+      /// Per spring (index 3 e + i) of a hysteretic facet: its uniaxial law and the
+      /// offset of its state in the facet's state (SpringLaw::uniaxial_spring()).
+      std::vector<SpringLaw::UniaxialSpring> uniaxial;
       std::vector<double>           w; ///< prescribed velocities at the last t
       Vector                        reaction, f_ext;
       dealii::SparsityPattern       pattern;
       dealii::SparseMatrix<double>  jacobian;
       dealii::SparseDirectUMFPACK   direct;
 
+      const Material::BoucWenUniaxial &
+      law(const unsigned int e, const unsigned int i) const
+      {
+        return *uniaxial[3 * e + i].law;
+      }
+      /// Spring i's state in the facet's state.
+      unsigned int
+      facet_offset(const unsigned int e, const unsigned int i) const
+      {
+        return uniaxial[3 * e + i].offset;
+      }
       unsigned int
       s_index(const unsigned int e, const unsigned int i) const
       {
@@ -187,12 +202,18 @@ namespace hysteron
       , n(model.u.size())
     {
       state_offset.assign(3 * m.springs.size(), -1);
+      uniaxial.assign(3 * m.springs.size(), SpringLaw::UniaxialSpring());
       for (unsigned int e = 0; e < m.springs.size(); ++e)
         if (m.springs[e].hysteretic)
           for (unsigned int i = 0; i < 3; ++i)
             {
+              uniaxial[3 * e + i] = m.spring_law->uniaxial_spring(e, i);
+              if (uniaxial[3 * e + i].law == nullptr)
+                throw std::logic_error("rbsn: the spring law '" + m.spring_law_name +
+                                       "' supports the variable-order analysis but gives no "
+                                       "uniaxial law of a spring");
               state_offset[3 * e + i] = n_states;
-              n_states += m.springs[e].law[i].n_state_variables();
+              n_states += law(e, i).n_state_variables();
             }
       n_total = 2 * n + n_states + 3;
       w.assign(n, 0.0);
@@ -225,7 +246,7 @@ namespace hysteron
             continue;
           for (unsigned int i = 0; i < 3; ++i)
             {
-              const unsigned int k = m.springs[e].law[i].n_state_variables(), s0 = s_index(e, i);
+              const unsigned int k = law(e, i).n_state_variables(), s0 = s_index(e, i);
               for (const unsigned int p : dofs)
                 dsp.add(n + p, s0);
               for (unsigned int a = 0; a < k; ++a)
@@ -258,13 +279,13 @@ namespace hysteron
         if (state_offset[3 * e] >= 0)
           for (unsigned int i = 0; i < 3; ++i)
             {
-              const auto        &law = m.springs[e].law[i];
-              const unsigned int s0  = s_index(e, i);
-              tolerances(s0)         = i == 2 ? atol / m.scale : atol;
-              if (law.degradation())
+              const auto        &spring = law(e, i);
+              const unsigned int s0     = s_index(e, i);
+              tolerances(s0)            = i == 2 ? atol / m.scale : atol;
+              if (spring.degradation())
                 {
                   tolerances(s0 + Material::BoucWenUniaxial::eta_index)    = p.relative_tolerance;
-                  tolerances(s0 + Material::BoucWenUniaxial::energy_index) = tolerances(s0) * law.yield_value();
+                  tolerances(s0 + Material::BoucWenUniaxial::energy_index) = tolerances(s0) * spring.yield_value();
                 }
             }
       // The works: 1e-2 k_max d atol, the work of the largest normal spring's force at
@@ -350,13 +371,13 @@ namespace hysteron
               if (sp.hysteretic)
                 {
                   // F = a k delta + (1 - a) k z, and s' = R(s, delta').
-                  const auto        &law = sp.law[i];
-                  const unsigned int s0  = s_index(e, i), k = law.n_state_variables();
+                  const auto        &spring = law(e, i);
+                  const unsigned int s0 = s_index(e, i), k = spring.n_state_variables();
                   double             state[Material::BoucWenUniaxial::max_n_state_variables], R[3];
                   for (unsigned int j = 0; j < k; ++j)
                     state[j] = y(s0 + j);
-                  force = law.stress(delta, state);
-                  law.state_rate(state, rate, R);
+                  force = spring.stress(delta, state);
+                  spring.state_rate(state, rate, R);
                   for (unsigned int j = 0; j < k; ++j)
                     F(s0 + j) = yp(s0 + j) - R[j];
                 }
@@ -421,7 +442,7 @@ namespace hysteron
           for (unsigned int i = 0; i < 3; ++i)
             {
               // dF/d delta = a k (the z part is a state of its own), dF/dz = (1 - a) k.
-              const double a  = sp.hysteretic ? sp.law[i].parameters().post_yield_ratio : 1.0;
+              const double a  = sp.hysteretic ? law(e, i).parameters().post_yield_ratio : 1.0;
               const double ka = a * sp.k[i], kv = a1 * sp.k[i], kz = (1 - a) * sp.k[i];
               for (unsigned int p = 0; p < 6; ++p)
                 if (free(dofs[p]))
@@ -434,8 +455,8 @@ namespace hysteron
                     }
               if (!sp.hysteretic)
                 continue;
-              const auto        &law = sp.law[i];
-              const unsigned int s0 = s_index(e, i), k = law.n_state_variables();
+              const auto        &spring = law(e, i);
+              const unsigned int s0 = s_index(e, i), k = spring.n_state_variables();
               for (unsigned int p = 0; p < 6; ++p)
                 if (free(dofs[p]))
                   jacobian.add(n + dofs[p], s0, sp.B(i, p) * kz);
@@ -443,7 +464,7 @@ namespace hysteron
               double state[3], dR_ds[9], dR_dr[3];
               for (unsigned int j = 0; j < k; ++j)
                 state[j] = y(s0 + j);
-              law.state_rate_derivatives(state, sp.deformation(i, V), dR_ds, dR_dr);
+              spring.state_rate_derivatives(state, sp.deformation(i, V), dR_ds, dR_dr);
               for (unsigned int r = 0; r < k; ++r)
                 {
                   for (unsigned int j = 0; j < k; ++j)
@@ -495,8 +516,8 @@ namespace hysteron
       for (unsigned int e = 0; e < m.springs.size(); ++e)
         if (state_offset[3 * e] >= 0)
           for (unsigned int i = 0; i < 3; ++i)
-            for (unsigned int j = 0; j < m.springs[e].law[i].n_state_variables(); ++j)
-              y(s_index(e, i) + j) = m.springs[e].state[3 * i + j];
+            for (unsigned int j = 0; j < law(e, i).n_state_variables(); ++j)
+              y(s_index(e, i) + j) = m.springs[e].state[facet_offset(e, i) + j];
       const unsigned int iw = 2 * n + n_states;
       y(iw)     = m.internal_work;
       y(iw + 1) = m.external_work;
@@ -533,9 +554,10 @@ namespace hysteron
               sp.delta[i] = sp.deformation(i, U);
               if (sp.hysteretic)
                 {
-                  for (unsigned int j = 0; j < sp.law[i].n_state_variables(); ++j)
-                    sp.state[3 * i + j] = y(s_index(e, i) + j);
-                  sp.force[i] = sp.law[i].stress(sp.delta[i], sp.state.data() + 3 * i);
+                  const auto &spring = law(e, i);
+                  for (unsigned int j = 0; j < spring.n_state_variables(); ++j)
+                    sp.state[facet_offset(e, i) + j] = y(s_index(e, i) + j);
+                  sp.force[i] = spring.stress(sp.delta[i], sp.state.data() + facet_offset(e, i));
                 }
               else
                 sp.force[i] = sp.k[i] * sp.delta[i];

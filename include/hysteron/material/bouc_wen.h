@@ -97,6 +97,13 @@ namespace hysteron
         return parameters;
       }
 
+      /// Uniaxial Bouc-Wen springs with these parameters.
+      SpringBehaviour
+      spring_behaviour() const override
+      {
+        return {SpringBehaviour::Type::bouc_wen, &parameters};
+      }
+
     protected:
       void
       parse_parameters(const Section &section) override;

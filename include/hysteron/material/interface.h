@@ -16,6 +16,27 @@ namespace hysteron
 {
   namespace Material
   {
+    struct BoucWenParameters;
+
+    /**
+     * What a spring network (RBSN) takes from a material for the springs of a
+     * facet between two of its cells: nothing (the material cannot be a body of a
+     * spring network), linear-elastic springs (k from the elastic constants), or
+     * uniaxial Bouc-Wen springs with the material's Bouc-Wen parameters (among them
+     * the yield stress sigma_y that the spring laws scale to yield forces).
+     */
+    struct SpringBehaviour
+    {
+      enum class Type
+      {
+        none,
+        linear_elastic,
+        bouc_wen
+      };
+      Type                     type     = Type::none;
+      const BoucWenParameters *bouc_wen = nullptr; ///< Type::bouc_wen: the parameters
+    };
+
     /**
      * The interface of every constitutive model (deal.II style: a class
      * templated on dim; SymmetricTensor at the interface).
@@ -127,6 +148,14 @@ namespace hysteron
       has_consistent_tangent() const
       {
         return true;
+      }
+
+      /// What springs between cells of this material follow (default: none, the
+      /// material cannot be a spring network's body).
+      virtual SpringBehaviour
+      spring_behaviour() const
+      {
+        return {};
       }
 
       /// Warnings found while reading the parameters (printed by the scene on rank 0).

@@ -21,6 +21,13 @@ namespace hysteron
              const dealii::ArrayView<double>                                &states,
              const dealii::ArrayView<dealii::SymmetricTensor<4, dim>> &tangents) const override;
 
+      /// Linear springs.
+      SpringBehaviour
+      spring_behaviour() const override
+      {
+        return {SpringBehaviour::Type::linear_elastic, nullptr};
+      }
+
     protected:
       void
       parse_parameters(const Section &section) override;

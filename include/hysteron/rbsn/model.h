@@ -12,8 +12,7 @@
 #include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>
 #include <hysteron/base/checkpoint.h>
-#include <hysteron/material/bouc_wen_interaction.h>
-#include <hysteron/material/bouc_wen_uniaxial.h>
+#include <hysteron/rbsn/spring_law.h>
 #include <hysteron/rbsn/tessellation.h>
 #include <hysteron/scene/method.h>
 #include <hysteron/scene/scene.h>
@@ -57,31 +56,21 @@ namespace hysteron
       double       initial_step       = 0; ///< [s]; 0: IDA's estimate
     };
 
-    /// The facet springs' Bouc-Wen law: three uniaxial laws (eq. 3.36) or one coupled
-    /// law with a yield criterion in the spring forces (eq. 3.38-3.42).
-    enum class SpringLaw
-    {
-      uncoupled,
-      coupled
-    };
-
     /**
-     * One facet's three springs (normal, tangential, rotational): stiffness,
-     * yield value, the uniaxial Bouc-Wen laws and their converged and trial
-     * state. Deformations delta = (delta_n, delta_t, phi) = B [u_a; u_b].
-     * With the coupled law, `coupled_law` replaces the three uniaxial laws; its
-     * state z_i is kept in the slot of spring i (state[3 i]), and D_t (3 x 3) replaces
-     * the diagonal `tangent`.
+     * One facet's three springs (normal, tangential, rotational): stiffness, the
+     * converged and trial deformations, forces and state of the spring law (see
+     * SpringLaw), and the tangent D = dF / d delta of the last evaluation.
+     * Deformations delta = (delta_n, delta_t, phi) = B [u_a; u_b].
      */
     struct Springs
     {
-      std::array<double, 3>                   k{}, yield{};
-      std::array<Material::BoucWenUniaxial, 3> law;
-      std::array<double, 3> delta{}, force{}, trial_delta{}, trial_force{}, tangent{};
-      std::array<double, 3 * Material::BoucWenUniaxial::max_n_state_variables> state{}, trial_state{};
+      std::array<double, 3> k{};
+      std::array<double, 3> delta{}, force{}, trial_delta{}, trial_force{};
+      SpringLaw::Matrix     tangent;              ///< diag(k) for linear springs
+      std::vector<double>   state, trial_state;   ///< the law's (hysteretic springs only)
       std::array<double, 6> B_n{}, B_t{}; ///< the rows n and t of B (the third is (0, 0, -1, 0, 0, 1))
       double                thickness  = 1;
-      bool                  hysteretic = false; ///< Bouc-Wen laws (else linear springs)
+      bool                  hysteretic = false; ///< the spring law's (else linear springs)
       bool                  broken     = false;
 
       /// B(i, k): row i (n, t, phi) of B, column k of U_e.
@@ -103,20 +92,6 @@ namespace hysteron
         for (unsigned int k = 0; k < 6; ++k)
           s += row[k] * U[k];
         return s;
-      }
-
-      bool                               coupled = false; ///< the coupled law (hysteretic only)
-      Material::BoucWenInteraction       coupled_law;
-      Material::BoucWenInteraction::Matrix tangent_matrix; ///< D_t of the coupled law
-
-      /// H1 of spring i for output: |z_i / z_y,i|^n, or Phi^n of the facet (the same value
-      /// for the three springs) with the coupled law; 0 for linear or broken springs.
-      double
-      h1(const unsigned int i) const
-      {
-        if (!hysteretic || broken)
-          return 0.0;
-        return coupled ? coupled_law.h1(state.data(), 3) : law[i].h1(state.data() + 3 * i);
       }
     };
 
@@ -251,6 +226,13 @@ namespace hysteron
       /// The fracture.csv row of a break of @p facet at time @p t (its trial forces).
       std::vector<double>
       break_row(const unsigned int facet, const double t) const;
+      /// H1 of spring @p i of facet @p e for output; 0 for linear or broken springs.
+      double
+      h1(const unsigned int e, const unsigned int i) const
+      {
+        const Springs &sp = springs[e];
+        return sp.hysteretic && !sp.broken ? spring_law->h1(e, i, sp.state.data()) : 0.0;
+      }
       /// The cell and facet of every probe point (a point outside the bodies is refused).
       void
       locate_probes();
@@ -292,7 +274,8 @@ namespace hysteron
       double                        boundary_h   = 0;
       double                        shear_ratio  = 0;
       double                        moment_yield = 0.25;
-      SpringLaw                     spring_law   = SpringLaw::uncoupled;
+      std::string                   spring_law_name;
+      std::unique_ptr<SpringLaw>    spring_law; ///< `RBSN/Spring law`
       Analysis                      analysis     = Analysis::quasi_static;
       double                        time_step    = 0;
       unsigned int                  n_increments = 100;

@@ -1,0 +1,100 @@
+// A no-tension facet spring law as a hysteron plugin: the whole of what a user writes to add
+// an RBSN spring law. Build it against the installed package (CMakeLists.txt beside this file)
+// and load it with `set Additional shared libraries = ./build/libcustom_spring_law.so`, then
+// choose it with `set Spring law = no tension` in `subsection RBSN`.
+//
+// Model (a masonry-like joint): the normal spring carries compression only,
+// F_n = k_n min(delta_n, 0), the tangential and rotational springs are linear,
+// F_t = k_t delta_t, M = k_phi phi. The law works on the total deformations, which it keeps
+// as its state (the interface passes increments); it applies to every material (linear
+// elastic ones too), so every facet is the law's. The tangent is diagonal: k_n in
+// compression, 0 in tension.
+#include <hysteron/rbsn/spring_law.h>
+
+#include <algorithm>
+
+namespace custom
+{
+  using hysteron::RBSN::FacetSprings;
+  using hysteron::RBSN::SpringLaw;
+
+  class NoTension : public SpringLaw
+  {
+  public:
+    /// The three total deformations (delta_n, delta_t, phi).
+    unsigned int
+    n_state_variables() const override
+    {
+      return 3;
+    }
+
+    bool
+    setup_facet(const unsigned int e,
+                const FacetSprings &springs,
+                const hysteron::Material::Interface<2> &,
+                const hysteron::Material::Interface<2> &,
+                double *state) override
+    {
+      k(e) = springs.k;
+      std::fill(state, state + 3, 0.0);
+      return true;
+    }
+
+    /// The tangent is exact (the material's own integrator plays no part).
+    bool
+    has_consistent_tangent(const hysteron::Material::Interface<2> &) const override
+    {
+      return true;
+    }
+
+    bool
+    diagonal_tangent() const override
+    {
+      return true;
+    }
+
+    void
+    update(const unsigned int e,
+           const Vector      &increment,
+           Vector            &force,
+           double            *delta,
+           Matrix            *tangent) const override
+    {
+      for (unsigned int i = 0; i < 3; ++i)
+        delta[i] += increment[i];
+      const bool open = delta[0] > 0;
+      force[0]        = open ? 0.0 : k[e][0] * delta[0];
+      force[1]        = k[e][1] * delta[1];
+      force[2]        = k[e][2] * delta[2];
+      if (tangent)
+        for (unsigned int i = 0; i < 3; ++i)
+          (*tangent)[i][i] = i == 0 && open ? 0.0 : k[e][i];
+    }
+
+    /// No yielding: H1 = 0.
+    double
+    h1(const unsigned int, const unsigned int, const double *) const override
+    {
+      return 0;
+    }
+
+    /// 1/2 k delta^2 (the normal spring in compression only).
+    double
+    strain_energy(const unsigned int e,
+                  const unsigned int i,
+                  const double       delta,
+                  const double *) const override
+    {
+      const double d = i == 0 ? std::min(delta, 0.0) : delta;
+      return 0.5 * k[e][i] * d * d;
+    }
+
+  private:
+    hysteron::RBSN::PerFacet<Vector> k; ///< per facet
+  };
+} // namespace custom
+
+HYSTERON_REGISTER_SPRING_LAW(custom::NoTension,
+                             "no tension",
+                             "example plugin: the normal spring carries compression only, "
+                             "F_n = k_n min(delta_n, 0); linear tangential and rotational springs")

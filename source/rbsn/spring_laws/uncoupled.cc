@@ -1,0 +1,125 @@
+#include <hysteron/base/exceptions.h>
+#include <hysteron/material/bouc_wen_parameters.h>
+#include <hysteron/material/bouc_wen_uniaxial.h>
+#include <hysteron/rbsn/spring_law.h>
+
+#include <vector>
+
+namespace hysteron
+{
+  namespace RBSN
+  {
+    namespace
+    {
+      /**
+       * Three independent uniaxial Bouc-Wen springs (eq. 3.32-3.36), each with its own
+       * yield value F_y,i (FacetSprings::yield_values of the smaller yield stress of the
+       * two cells) and the Bouc-Wen parameters of cell a's material. The state of spring
+       * i lies at state[3 i] (BoucWenUniaxial::max_n_state_variables each: z, and eta
+       * and e_h with degradation); the tangent is diagonal.
+       */
+      class Uncoupled : public SpringLaw
+      {
+      public:
+        static constexpr unsigned int stride = Material::BoucWenUniaxial::max_n_state_variables;
+
+        unsigned int
+        n_state_variables() const override
+        {
+          return 3 * stride;
+        }
+
+        bool
+        setup_facet(const unsigned int            e,
+                    const FacetSprings           &springs,
+                    const Material::Interface<2> &a,
+                    const Material::Interface<2> &b,
+                    double                       *state) override
+        {
+          const Material::BoucWenParameters *prm = bouc_wen_springs(a, b);
+          if (prm == nullptr)
+            return false;
+          auto      &facet = laws(e);
+          const auto yield = springs.yield_values(facet_yield_stress(a, b));
+          for (unsigned int i = 0; i < 3; ++i)
+            {
+              facet[i].reinit(*prm, springs.k[i], yield[i]);
+              facet[i].initialize_state(state + stride * i);
+            }
+          return true;
+        }
+
+        bool
+        diagonal_tangent() const override
+        {
+          return true;
+        }
+
+        void
+        update(const unsigned int e,
+               const Vector      &increment,
+               Vector            &force,
+               double            *state,
+               Matrix            *tangent) const override
+        {
+          // Every spring is advanced even if one fails, so that the trial state is the
+          // same as spring-by-spring; the last failure is reported.
+          std::string cause, spring;
+          for (unsigned int i = 0; i < 3; ++i)
+            try
+              {
+                laws[e][i].update(increment[i], force[i], state + stride * i,
+                                  tangent ? &(*tangent)[i][i] : nullptr);
+              }
+            catch (const RuntimeError &error)
+              {
+                cause  = error.what();
+                spring = std::string("the ") +
+                         (i == 0 ? "normal" : i == 1 ? "tangential" : "rotational") + " spring";
+              }
+          if (!cause.empty())
+            throw SpringFailure(cause, spring);
+        }
+
+        double
+        h1(const unsigned int e, const unsigned int i, const double *state) const override
+        {
+          return laws[e][i].h1(state + stride * i);
+        }
+
+        double
+        strain_energy(const unsigned int e,
+                      const unsigned int i,
+                      const double       delta,
+                      const double      *state) const override
+        {
+          const auto &law = laws[e][i];
+          return bouc_wen_strain_energy(law.parameters().post_yield_ratio, law.stiffness(), delta,
+                                        state[stride * i]);
+        }
+
+        std::string
+        variable_order_unsupported() const override
+        {
+          return "";
+        }
+
+        UniaxialSpring
+        uniaxial_spring(const unsigned int e, const unsigned int i) const override
+        {
+          return {&laws[e][i], stride * i};
+        }
+
+      private:
+        PerFacet<std::array<Material::BoucWenUniaxial, 3>> laws;
+      };
+    } // namespace
+  } // namespace RBSN
+} // namespace hysteron
+
+HYSTERON_REGISTER_SPRING_LAW(hysteron::RBSN::Uncoupled,
+                             "uncoupled",
+                             "three uniaxial Bouc-Wen laws (eq. 3.36), each yielding at its own "
+                             "F_y: sigma_y t l (normal), sigma_y t l / sqrt(3) (tangential), "
+                             "factor sigma_y t l^2 (rotational); sigma_y and the Bouc-Wen "
+                             "parameters from the cells' material")
