@@ -1,0 +1,234 @@
+#ifndef hysteron_source_material_bouc_wen_explicit_h
+#define hysteron_source_material_bouc_wen_explicit_h
+
+// The explicit integrators of the Bouc-Wen point kernels (forward Euler, the adaptive
+// embedded pair, drift correction and sub-stepping): members of BoucWenKernels::Law
+// declared in bouc_wen_kernels.h, which includes this file at its end, with the equations
+// documented there.
+
+namespace hysteron
+{
+  namespace Material
+  {
+    namespace BoucWenKernels
+    {
+      template <StressState S, bool kinematic, bool degrading>
+      inline void
+      Law<S, kinematic, degrading>::forward_euler(const Constants &c, VecN &y, const VecK &deps, Rates &r)
+      {
+        VecK De;
+        apply_D(c, deps.data(), De.data());
+        VecN dy;
+        rates(c, y.data(), De, dy.data(), r);
+        for (unsigned int i = 0; i < N; ++i)
+          y[i] += dy[i];
+      }
+
+
+
+      template <StressState S, bool kinematic, bool degrading>
+      inline double
+      Law<S, kinematic, degrading>::error_norm(const Constants &c, const VecN &err)
+      {
+        double e = 0;
+        for (unsigned int a = 0; a < K; ++a)
+          e = max_nan(e, std::abs(err[a]) * c.inv_sigma_y0);
+        for (unsigned int i = K; i <= i_eps_ps; ++i)
+          e = max_nan(e, std::abs(err[i]) * c.inv_eps_y);
+        if (degrading)
+          e = max_nan(e, std::abs(err[i_e_h]) * c.inv_energy);
+        if (track_eps_zz)
+          e = max_nan(e, std::abs(err[i_eps_zz]) * c.inv_eps_y);
+        return e * c.inv_tol;
+      }
+
+
+
+      template <StressState S, bool kinematic, bool degrading>
+      inline void
+      Law<S, kinematic, degrading>::plastic_correction(const Constants &c, VecN &y, const Rates &r, const double dlambda)
+      {
+        double sn = 0;
+        for (unsigned int a = 0; a < K; ++a)
+          sn += y[a] * r.n[G::full[a]];
+        const double s0 = y[0], s1 = y[1];
+        for (unsigned int a = 0; a < K; ++a)
+          y[a] -= dlambda * r.Dn[a];
+        for (unsigned int f = 0; f < F; ++f)
+          y[i_epsp + f] += dlambda * r.n[f];
+        y[i_eps_ps] += std::abs(dlambda);
+        if (degrading)
+          y[i_e_h] += dlambda * sn;
+        if (track_eps_zz)
+          y[i_eps_zz] += r.eta * (-c.nu / c.E * (y[0] - s0 + y[1] - s1) + dlambda * r.n[2]);
+      }
+
+
+
+      template <StressState S, bool kinematic, bool degrading>
+      inline void
+      Law<S, kinematic, degrading>::drift_correction(const Constants &c, VecN &y, Rates &r)
+      {
+        for (unsigned int iteration = 0; iteration < 5; ++iteration)
+          {
+            const double scale  = degrading ? std::pow(r.nu, -1.0 / c.n) : 1.0;
+            const double target = r.sigma_y * scale;
+            if (!(r.q > target * (1 + 1e-14)) || r.lambda1 == 0)
+              break;
+            // d(q - q*)/d dlambda = -(n:D:n + (1 - m) H' + m H' nu^(-1/n))
+            //                       + q* / (n nu) c_nu sigma:n / (sigma_y0 eps_y)
+            double slope = 1.0 / r.lambda1 - c.H + c.kin_q + c.iso * scale;
+            if (degrading)
+              {
+                double sn = 0;
+                for (unsigned int a = 0; a < K; ++a)
+                  sn += y[a] * r.n[G::full[a]];
+                slope -= target / (c.n * r.nu) * c.c_nu_scaled * sn;
+              }
+            if (!(slope > 0))
+              break;
+            plastic_correction(c, y, r, (r.q - target) / slope);
+            VecF alpha, dev;
+            if (kinematic)
+              for (unsigned int f = 0; f < F; ++f)
+                alpha[f] = c.kin * y[i_epsp + f];
+            r.q       = relative_deviator(y.data(), kinematic ? alpha.data() : nullptr, dev);
+            r.sigma_y = c.sigma_y0 + c.iso * y[i_eps_ps];
+            if (degrading)
+              r.nu = 1.0 + c.c_nu_scaled * y[i_e_h];
+            r.H1 = H1_of(c, r.q, r.sigma_y);
+          }
+      }
+
+
+
+      template <StressState S, bool kinematic, bool degrading>
+      inline double
+      Law<S, kinematic, degrading>::bs32_error(const Constants &c,
+                                               const double     h,
+                                               const VecN      &k1,
+                                               const VecN      &k2,
+                                               const VecN      &k3,
+                                               const VecN      &k4)
+      {
+        VecN err;
+        for (unsigned int i = 0; i < N; ++i)
+          err[i] = h * (-5.0 / 72.0 * k1[i] + 1.0 / 12.0 * k2[i] + 1.0 / 9.0 * k3[i] -
+                        0.125 * k4[i]);
+        return error_norm(c, err);
+      }
+
+
+
+      template <StressState S, bool kinematic, bool degrading>
+      inline unsigned int
+      Law<S, kinematic, degrading>::substeps(const Constants &c,
+                                             VecN            &y,
+                                             const VecK      &De,
+                                             VecN            &k1,
+                                             double           H1_now,
+                                             double           h,
+                                             unsigned int     attempts,
+                                             Rates           &r,
+                                             const bool       full_rates)
+      {
+        VecN   k2, k3, k4, yt, y_new;
+        Stage  stage;
+        double s = 0;
+        while (true)
+          {
+            if (++attempts > c.max_substeps)
+              {
+                std::ostringstream m;
+                m << "Bouc-Wen (adaptive integrator): more than " << c.max_substeps
+                  << " sub-steps for one strain increment (reached s = " << s << ", sub-step "
+                  << h << ", H1 = " << H1_now
+                  << "). Reduce the strain increment or raise Material/Bouc-Wen/Tolerance.";
+                throw RuntimeError(m.str());
+              }
+            const bool last = (s + h >= 1.0);
+            if (last)
+              h = 1.0 - s;
+            for (unsigned int i = 0; i < N; ++i)
+              yt[i] = y[i] + 0.5 * h * k1[i];
+            stage_rates(c, yt.data(), De, k2.data());
+            for (unsigned int i = 0; i < N; ++i)
+              yt[i] = y[i] + 0.75 * h * k2[i];
+            stage_rates(c, yt.data(), De, k3.data());
+            for (unsigned int i = 0; i < N; ++i)
+              y_new[i] = y[i] + h * (2.0 / 9.0 * k1[i] + 1.0 / 3.0 * k2[i] + 4.0 / 9.0 * k3[i]);
+            const bool   full_new = last && full_rates;
+            const double H1_new   = full_new ?
+                                      (rates(c, y_new.data(), De, k4.data(), r), r.H1) :
+                                      stage_rates(c, y_new.data(), De, k4.data(), &stage);
+            const double e        = bs32_error(c, h, k1, k2, k3, k4);
+            if (!std::isfinite(e))
+              {
+                // Overflow in a too long trial step (H1 = (q/sigma_y)^n explodes for
+                // large n): shorten it; a non-finite start is an error.
+                bool finite = true;
+                for (unsigned int i = 0; i < N; ++i)
+                  finite = finite && std::isfinite(y[i]) && std::isfinite(k1[i]);
+                if (!finite)
+                  {
+                    std::ostringstream m;
+                    m << "Bouc-Wen (adaptive integrator): non-finite rates at s = " << s
+                      << " of a strain increment (stress, state or increment not finite)";
+                    throw RuntimeError(m.str());
+                  }
+                h *= 0.1;
+              }
+            else if (const double es =
+                       (e <= 1.0 ? stiff_error(c, h, y, k1, k4, H1_now, H1_new) : 0.0);
+                     es > 1.0)
+              h *= std::max(0.2, 0.9 / std::sqrt(std::sqrt(es)));
+            else if (e <= 1.0)
+              {
+                y      = y_new;
+                k1     = k4;
+                H1_now = H1_new;
+                if (last)
+                  {
+                    finish(c, y, De, stage, r, full_new);
+                    return attempts;
+                  }
+                s += h;
+                h *= (e > 0) ? std::min(5.0, 0.9 / std::cbrt(e)) : 5.0;
+              }
+            else
+              h *= std::max(0.2, 0.9 / std::cbrt(e));
+            if (h < 1e-13)
+              {
+                std::ostringstream m;
+                m << "Bouc-Wen (adaptive integrator): the sub-step fell below 1e-13 of the "
+                     "increment at s = "
+                  << s << " (H1 = " << H1_now
+                  << "): the tolerance cannot be met in double precision. Raise "
+                     "Material/Bouc-Wen/Tolerance.";
+                throw RuntimeError(m.str());
+              }
+          }
+      }
+
+
+
+      template <StressState S, bool kinematic, bool degrading>
+      inline unsigned int
+      Law<S, kinematic, degrading>::adaptive(const Constants &c,
+                                             VecN            &y,
+                                             const VecK      &deps,
+                                             Rates           &r,
+                                             const bool       full_rates)
+      {
+        VecK De;
+        apply_D(c, deps.data(), De.data());
+        VecN  k1;
+        Stage st;
+        stage_rates(c, y.data(), De, k1.data(), &st);
+        return substeps(c, y, De, k1, st.H1, 1.0, 0, r, full_rates);
+      }
+    } // namespace BoucWenKernels
+  }   // namespace Material
+} // namespace hysteron
+
+#endif
