@@ -43,6 +43,8 @@ namespace hysteron
       out.put(n_broken);
       out.put(n_cuts);
       out.put(increments.state());
+      out.section("rbsn fracture energy");
+      out.put(fracture_energy);
       tables.save(out);
     }
 
@@ -95,6 +97,9 @@ namespace hysteron
       in.get(n_broken);
       in.get(n_cuts);
       increments.restore(in.get<std::array<double, 4>>());
+      in.section("rbsn fracture energy");
+      in.get(fracture_energy);
+      update_fragments(); // from the broken facets
       tables.load(in);
     }
   } // namespace RBSN

@@ -484,6 +484,13 @@ namespace hysteron
                 constraints.set_inhomogeneity(dof, prescribed_increment(set, dof, t0, t1));
             }
         }
+      // Released cells (a fragment nothing holds) keep their displacements.
+      if (n_released > 0)
+        for (unsigned int c = 0; c < released.size(); ++c)
+          if (released[c])
+            for (unsigned int k = 0; k < 3; ++k)
+              if (!constraints.is_constrained(3 * c + k))
+                constraints.add_line(3 * c + k);
       constraints.close();
     }
 
@@ -605,7 +612,13 @@ namespace hysteron
         << (analysis == Analysis::variable_order ? n_steps : steps) << " steps, " << n_newton
         << " Newton iterations";
       if (fracture.enabled)
-        s << ", " << n_broken << " broken facets";
+        {
+          s << ", " << n_broken << " broken facets, " << n_fragments << (n_fragments == 1 ? " fragment" : " fragments");
+          if (n_released > 0)
+            s << " (" << n_released << (n_released == 1 ? " cell" : " cells") << " released)";
+          if (fracture_energy > 0)
+            s << ", fracture energy " << fracture_energy << " J";
+        }
       s << ", " << outputs << " outputs";
       return s.str();
     }

@@ -32,7 +32,12 @@ namespace hysteron
       std::fill(out + 8, out + 17, 0.0);
       if (e < 0)
         return;
-      const Springs &sp   = springs[e];
+      const Springs &sp = springs[e];
+      if (sp.broken)
+        {
+          out[16] = 1; // no force, no state
+          return;
+        }
       const double   area = sp.thickness * network.facets[e].length;
       out[8]  = sp.force[0];
       out[9]  = sp.force[1];
@@ -41,7 +46,6 @@ namespace hysteron
       out[12] = sp.force[1] / area;
       for (unsigned int i = 0; i < 3; ++i)
         out[13 + i] = h1(e, i); // the coupled law: Phi^n of the facet in all three
-      out[16] = sp.broken ? 1.0 : 0.0;
     }
 
 
@@ -97,20 +101,24 @@ namespace hysteron
       if (fracture.enabled)
         fracture_table = std::make_unique<Output::TimeTable>(
           method.output_file("fracture.csv"),
-          std::vector<std::string>{"time", "facet", "x", "y", "s_n", "s_t", "R"});
+          std::vector<std::string>{"time", "facet", "x", "y", "s_n", "s_t", "R", "fragments",
+                                   "separated_cells", "separated_x", "separated_y",
+                                   "released_cells"});
     }
 
 
 
     std::vector<double>
-    Model::break_row(const unsigned int e, const double t) const
+    Model::break_row(const unsigned int e, const double t, const Separation &separated) const
     {
       const Springs &sp   = springs[e];
       const double   area = sp.thickness * network.facets[e].length;
       const double   s_n = sp.trial_force[0] / area, s_t = sp.trial_force[1] / area;
       const double   R = std::max(s_n / fracture.tensile_strength,
                                 (std::abs(s_t) + fracture.friction * s_n) / fracture.cohesion);
-      return {t, double(e), network.facets[e].midpoint[0], network.facets[e].midpoint[1], s_n, s_t, R};
+      return {t, double(e), network.facets[e].midpoint[0], network.facets[e].midpoint[1], s_n, s_t, R,
+              double(n_fragments), double(separated.cells), separated.centroid[0],
+              separated.centroid[1], double(separated.released)};
     }
 
 
@@ -192,7 +200,7 @@ namespace hysteron
       std::vector<dealii::Point<2>> points;
       std::vector<double>           displacement;
       std::vector<unsigned int>     offsets, connectivity;
-      std::vector<int>              types, cell_index, facet_index, body;
+      std::vector<int>              types, cell_index, facet_index, body, part, loose;
       std::vector<double>           theta, h1;
       std::array<std::vector<double>, 5> forces; // f_n, f_t, m, s_n, s_t of the facet lines
       std::vector<int>              broken;
@@ -219,6 +227,8 @@ namespace hysteron
             cell_index.push_back(c);
             facet_index.push_back(-1);
             body.push_back(cell_body[c]);
+            part.push_back(fragment[c]);
+            loose.push_back(released[c] ? 1 : 0);
             theta.push_back(u(3 * c + 2));
             h1.push_back(cell_h1[c]);
             for (auto &f : forces)
@@ -238,6 +248,8 @@ namespace hysteron
           cell_index.push_back(-1);
           facet_index.push_back(e);
           body.push_back(cell_body[f.a]);
+          part.push_back(fragment[f.a]);
+          loose.push_back(released[f.a] ? 1 : 0);
           theta.push_back(0);
           h1.push_back(std::max({this->h1(e, 0), this->h1(e, 1), this->h1(e, 2)}));
           const double area = sp.thickness * f.length;
@@ -284,6 +296,8 @@ namespace hysteron
       integers("facet", facet_index);
       integers("body", body);
       integers("broken", broken);
+      integers("fragment", part);
+      integers("released", loose);
       reals("rotation", theta);
       reals("H1", h1);
       const char *force_names[5] = {"f_n", "f_t", "m", "s_n", "s_t"};

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <iostream>
 #include <sstream>
 #include <vector>
 
@@ -163,6 +164,23 @@ namespace hysteron
             constraints.distribute_local_to_global(r, dofs, rhs);
         }
 
+      if (with_matrix && !dynamic && !lone_cells.empty())
+        {
+          // A cell without an intact facet (constrained: released or held in full) has
+          // no matrix entry: a diagonal of the springs' scale keeps the matrix regular.
+          dealii::FullMatrix<double>                   D(3, 3);
+          dealii::Vector<double>                       zero(3);
+          std::vector<dealii::types::global_dof_index> cd(3);
+          for (unsigned int k = 0; k < 3; ++k)
+            D(k, k) = springs.empty() ? 1.0 : springs[0].k[0];
+          for (const unsigned int c : lone_cells)
+            {
+              for (unsigned int k = 0; k < 3; ++k)
+                cd[k] = 3 * c + k;
+              constraints.distribute_local_to_global(D, zero, cd, matrix, rhs, true);
+            }
+        }
+
       if (dynamic)
         {
           // The cells: M a1 + (1 + alpha) a0 M v1 - alpha a0 M v0, tangent c_M M.
@@ -265,15 +283,15 @@ namespace hysteron
 
 
     void
-    Model::commit(const double t1, const double dt)
+    Model::commit(const double dt, const bool broke)
     {
-      (void)t1;
+      double work = 0; // of the intact springs in the step (trapezoidal rule)
       for (auto &sp : springs)
         {
           if (sp.broken)
             continue;
           for (unsigned int i = 0; i < 3; ++i)
-            internal_work += 0.5 * (sp.force[i] + sp.trial_force[i]) * (sp.trial_delta[i] - sp.delta[i]);
+            work += 0.5 * (sp.force[i] + sp.trial_force[i]) * (sp.trial_delta[i] - sp.delta[i]);
           sp.delta = sp.trial_delta;
           sp.force = sp.trial_force;
           sp.state = sp.trial_state;
@@ -289,14 +307,28 @@ namespace hysteron
           v = increment;
           v /= dt;
         }
+      double external = 0, boundary = 0;
       for (unsigned int i = 0; i < u.size(); ++i)
-        external_work += 0.5 * (f_ext_old(i) + f_ext(i)) * increment(i);
+        external += 0.5 * (f_ext_old(i) + f_ext(i)) * increment(i);
       Vector reaction = f_int;
       reaction += inertia;
       reaction -= f_ext;
       for (unsigned int i = 0; i < u.size(); ++i)
         if (dof_set[i] >= 0)
-          boundary_work += 0.5 * (reaction_old(i) + reaction(i)) * increment(i);
+          boundary += 0.5 * (reaction_old(i) + reaction(i)) * increment(i);
+      external_work += external;
+      boundary_work += boundary;
+      // A brittle break in a static step has no quasi-static path: the intact springs
+      // unload at once and the energy they give back, with the broken springs' own, is
+      // spent in the fracture. Its measure is what the step's loads and supports did
+      // beyond the springs' work; the internal work takes it, so that the dissipation
+      // (internal work - strain energy) includes the fracture energy.
+      if (broke && !dynamic())
+        {
+          fracture_energy += external + boundary - work;
+          work = external + boundary;
+        }
+      internal_work += work;
       reaction_old = reaction;
       f_ext_old    = f_ext;
       force_scale  = std::max(force_scale, last_force_level);
@@ -405,6 +437,7 @@ namespace hysteron
       setup_system();
       setup_conditions();
       check_supports();
+      update_fragments();
       locate_probes();
       scene.console() << "rbsn: " << network.cells.size() << " cells, " << network.facets.size()
                       << " facets (d_m = " << d_m << " m), " << 3 * network.cells.size() << " DoFs"
@@ -487,17 +520,25 @@ namespace hysteron
       // and by a failing run (what broke in the failed attempt).
       std::vector<unsigned int>        broken_since_t;
       std::vector<std::vector<double>> break_rows;
+      std::vector<std::string>         break_messages; // of released fragments
       const auto                       restore_t = [&]() {
         for (const unsigned int e : broken_since_t)
           springs[e].broken = false;
         n_broken -= broken_since_t.size();
+        if (!broken_since_t.empty())
+          update_fragments();
         broken_since_t.clear();
+        break_messages.clear();
       };
       const auto write_breaks = [&]() {
         if (fracture_table)
           for (const auto &row : break_rows)
             fracture_table->add_row(row);
         break_rows.clear();
+        if (scene.is_root())
+          for (const auto &m : break_messages)
+            std::cerr << "hysteron: warning: " << m << std::endl;
+        break_messages.clear();
       };
       const auto fail_at_t = [&](const std::string &what) {
         restore_t();
@@ -524,10 +565,32 @@ namespace hysteron
             fail_at_t("rbsn: more than " + std::to_string(fracture.max_cycles) +
                       " facets break in the step to t = " + std::to_string(t + dt) +
                       " s: the network falls apart.");
-          break_rows.push_back(break_row(e, t + dt));
           springs[e].broken = true;
           ++n_broken;
           broken_since_t.push_back(e);
+          const std::vector<bool> released_before = released;
+          update_fragments();
+          const Separation separated = separation(e, released_before);
+          break_rows.push_back(break_row(e, t + dt, separated));
+          if (separated.released > 0)
+            {
+              const auto xy = [](const dealii::Point<2> &p) {
+                std::ostringstream s;
+                s << "(" << p[0] << ", " << p[1] << ")";
+                return s.str();
+              };
+              const bool         one = separated.released == 1;
+              std::ostringstream m;
+              m << "rbsn: t = " << t + dt << " s: the facet at " << xy(network.facets[e].midpoint)
+                << " broke and cut off " << separated.released << (one ? " cell" : " cells")
+                << " around " << xy(separated.released_centroid) << " that nothing holds: "
+                << (one ? "it keeps its last state and leaves" : "they keep their last state and leave")
+                << " the static system";
+              if (separated.load.norm() > 1e-12 * std::max(force_scale, last_force_level))
+                m << "; the load on " << (one ? "it" : "them") << ", "
+                  << xy(dealii::Point<2>(separated.load)) << " N, is no longer carried";
+              break_messages.push_back(m.str() + ".");
+            }
           try
             {
               converged = solve_step(t, dt);
@@ -567,7 +630,7 @@ namespace hysteron
           break_rows.clear();
           return false;
         }
-      commit(t + dt, dt);
+      commit(dt, !broken_since_t.empty());
       write_breaks();
       increments.accept(t, dt);
       n_cuts = increments.cuts();

@@ -180,6 +180,28 @@ namespace hysteron
       /// Static analyses: refuse a network part whose rigid-body motions are free (supports.cc).
       void
       check_supports() const;
+      /// The connected parts of the network over all its facets, or over the intact ones
+      /// with @p intact_only (the part of every cell into @p part), and for each part the
+      /// rigid-body motions its supports leave free (empty: held).
+      std::vector<std::vector<std::string>>
+      network_parts(bool intact_only, std::vector<unsigned int> &part) const;
+
+      /// What a break did to the network (fracture.csv, console).
+      struct Separation
+      {
+        unsigned int         cells    = 0; ///< of the smaller fragment it cut off (0: none)
+        unsigned int         released = 0; ///< cells it released from the static system
+        dealii::Point<2>     centroid, released_centroid;
+        dealii::Tensor<1, 2> load; ///< the external force on the released cells [N]
+      };
+      /// The fragments over the intact facets, and (static analyses) the cells of the
+      /// fragments that nothing holds: released, their DoFs keep their values.
+      void
+      update_fragments();
+      /// What the break of facet @p e did, after update_fragments(), given the released
+      /// cells before it.
+      Separation
+      separation(unsigned int e, const std::vector<bool> &released_before) const;
 
       // Steps.
       void
@@ -188,8 +210,9 @@ namespace hysteron
       assemble(const double t1, const double dt, const bool matrix, const bool update_springs);
       bool
       solve_step(const double t, const double dt);
+      /// Accept the trial state of a step of @p dt (in which facets @p broke).
       void
-      commit(const double t1, const double dt);
+      commit(const double dt, const bool broke);
       void
       solve_linear(Vector &x);
       /// The facet whose fracture ratio R is largest if above 1, else -1.
@@ -223,9 +246,10 @@ namespace hysteron
       {
         return std::max({last_force_level, 1e-3 * force_scale, 1e-6 * predictor_level});
       }
-      /// The fracture.csv row of a break of @p facet at time @p t (its trial forces).
+      /// The fracture.csv row of a break of @p facet at time @p t (its trial forces) and
+      /// what it separated.
       std::vector<double>
-      break_row(const unsigned int facet, const double t) const;
+      break_row(const unsigned int facet, const double t, const Separation &separated) const;
       /// H1 of spring @p i of facet @p e for output; 0 for linear or broken springs.
       double
       h1(const unsigned int e, const unsigned int i) const
@@ -316,11 +340,20 @@ namespace hysteron
       /// The load increments (cuts and recovery).
       IncrementControl increments{1.0, 0};
       double internal_work = 0, external_work = 0, boundary_work = 0;
+      double fracture_energy = 0; ///< released by breaks in static steps (in internal_work)
       unsigned long n_steps = 0; ///< variable order: IDA's steps
       unsigned long n_newton = 0, n_broken = 0;
       unsigned int  n_cuts = 0;
       std::string   spring_failure;
       std::vector<int>              probe_cell, probe_facet;
+
+      // Fragments (supports.cc): the part of every cell over the intact facets, and the
+      // cells a static analysis has released (their fragment is not held).
+      std::vector<unsigned int> fragment;
+      std::vector<bool>         released;
+      std::vector<unsigned int> lone_cells; ///< fragments of one cell (no intact facet)
+      unsigned int              n_fragments = 0;
+      unsigned long             n_released  = 0;
     };
   } // namespace RBSN
 } // namespace hysteron
