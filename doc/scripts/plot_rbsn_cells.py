@@ -6,12 +6,14 @@ Usage:
   plot_rbsn_cells.py FILE.vtu OUT.png [--field H1] [--magnify 50] [--title "..."]
                      [--xlim a b] [--ylim a b] [--label "colour bar label"]
 
-The VTU is the ASCII file hysteron writes (polygons: VTK type 7; facets: type 3, with the
-cell field broken).
+The VTU is the file hysteron writes (inline binary arrays, base64 with a UInt64 byte count;
+older ASCII files are read too; polygons: VTK type 7; facets: type 3, with the cell field broken).
 Needs python3-matplotlib (Debian's /usr/bin/python3).
 """
 import argparse
+import base64
 import re
+import struct
 import sys
 
 import matplotlib
@@ -21,17 +23,30 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 
 
+FORMATS = {"Float64": "d", "Float32": "f", "Int64": "q", "Int32": "i", "UInt8": "B"}
+
+
+def decode(attributes, body):
+    """The values of one DataArray: ASCII, or base64 of a UInt64 byte count and the bytes."""
+    if 'format="binary"' not in attributes:
+        return [float(v) for v in body.split()]
+    code = FORMATS[re.search(r'type="(\w+)"', attributes).group(1)]
+    raw = base64.b64decode("".join(body.split()))
+    count = struct.unpack("<Q", raw[:8])[0]
+    return [float(v) for v in struct.unpack("<%d%s" % (count // struct.calcsize(code), code), raw[8:8 + count])]
+
+
 def read_vtu(path):
     text = open(path).read()
 
     def array(name):
-        m = re.search(r'<DataArray[^>]*Name="%s"[^>]*>(.*?)</DataArray>' % re.escape(name), text, re.S)
-        return None if m is None else [float(v) for v in m.group(1).split()]
+        m = re.search(r'<DataArray([^>]*Name="%s"[^>]*)>(.*?)</DataArray>' % re.escape(name), text, re.S)
+        return None if m is None else decode(m.group(1), m.group(2))
 
-    m = re.search(r"<Points>\s*<DataArray[^>]*>(.*?)</DataArray>", text, re.S)
+    m = re.search(r"<Points>\s*<DataArray([^>]*)>(.*?)</DataArray>", text, re.S)
     if m is None:
         sys.exit(f"plot_rbsn_cells: {path} has no <Points>")
-    xyz = [float(v) for v in m.group(1).split()]
+    xyz = decode(m.group(1), m.group(2))
     points = list(zip(xyz[0::3], xyz[1::3]))
     connectivity = [int(v) for v in array("connectivity")]
     offsets = [int(v) for v in array("offsets")]

@@ -21,6 +21,34 @@ namespace hysteron
   namespace Output
   {
     void
+    write_base64(std::ostream &out, const void *data, const std::size_t bytes)
+    {
+      // The byte count, then the bytes, as one base64 stream (3 bytes -> 4 characters).
+      static const char  table[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+      const std::uint64_t count   = bytes;
+      std::string         raw(sizeof(count) + bytes, '\0');
+      std::memcpy(raw.data(), &count, sizeof(count));
+      if (bytes > 0)
+        std::memcpy(raw.data() + sizeof(count), data, bytes);
+      std::string encoded;
+      encoded.reserve(4 * ((raw.size() + 2) / 3));
+      for (std::size_t i = 0; i < raw.size(); i += 3)
+        {
+          const std::size_t   n = std::min<std::size_t>(3, raw.size() - i);
+          const std::uint32_t v = (std::uint32_t(static_cast<unsigned char>(raw[i])) << 16) |
+                                  (n > 1 ? std::uint32_t(static_cast<unsigned char>(raw[i + 1])) << 8 : 0) |
+                                  (n > 2 ? std::uint32_t(static_cast<unsigned char>(raw[i + 2])) : 0);
+          encoded += table[(v >> 18) & 63];
+          encoded += table[(v >> 12) & 63];
+          encoded += n > 1 ? table[(v >> 6) & 63] : '=';
+          encoded += n > 2 ? table[v & 63] : '=';
+        }
+      out << encoded;
+    }
+
+
+
+    void
     prepare_directory(const std::string &directory, const std::string &where)
     {
       namespace fs = std::filesystem;

@@ -43,8 +43,9 @@ namespace hysteron
       out.put(n_broken);
       out.put(n_cuts);
       out.put(increments.state());
-      out.section("rbsn fracture energy");
+      out.section("rbsn fracture energy, factorizations");
       out.put(fracture_energy);
+      out.put(n_factorizations);
       tables.save(out);
     }
 
@@ -97,8 +98,9 @@ namespace hysteron
       in.get(n_broken);
       in.get(n_cuts);
       increments.restore(in.get<std::array<double, 4>>());
-      in.section("rbsn fracture energy");
+      in.section("rbsn fracture energy, factorizations");
       in.get(fracture_energy);
+      in.get(n_factorizations);
       update_fragments(); // from the broken facets
       tables.load(in);
     }

@@ -1,8 +1,10 @@
+#include <hysteron/base/output.h>
 #include <hysteron/rbsn/model.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 
@@ -258,39 +260,41 @@ namespace hysteron
             forces[k].push_back(sp.broken ? 0.0 : values[k]);
           broken.push_back(sp.broken ? 1 : 0);
         }
-      out.precision(10);
-      out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
-             "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\""
-          << points.size() << "\" NumberOfCells=\"" << types.size() << "\">\n<Points>\n"
-          << "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+      // VTK XML with inline binary arrays: base64 of a UInt64 byte count and the raw
+      // little-endian values (a 100,000-cell network writes in a fraction of the ASCII time).
+      out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
+             "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n<Piece "
+             "NumberOfPoints=\""
+          << points.size() << "\" NumberOfCells=\"" << types.size() << "\">\n<Points>\n";
+      std::vector<double> xyz;
+      xyz.reserve(3 * points.size());
       for (const auto &p : points)
-        out << p[0] << ' ' << p[1] << " 0\n";
-      out << "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" "
-             "format=\"ascii\">\n";
-      for (const auto i : connectivity)
-        out << i << ' ';
-      out << "\n</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-      for (const auto i : offsets)
-        out << i << ' ';
-      out << "\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-      for (const auto i : types)
-        out << i << ' ';
-      out << "\n</DataArray>\n</Cells>\n<PointData Vectors=\"displacement\">\n"
-          << "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-      for (unsigned int k = 0; k < points.size(); ++k)
-        out << displacement[2 * k] << ' ' << displacement[2 * k + 1] << " 0\n";
-      out << "</DataArray>\n</PointData>\n<CellData>\n";
-      const auto integers = [&](const char *name, const std::vector<int> &values) {
-        out << "<DataArray type=\"Int32\" Name=\"" << name << "\" format=\"ascii\">\n";
-        for (const auto x : values)
-          out << x << ' ';
+        xyz.insert(xyz.end(), {p[0], p[1], 0.0});
+      const auto array = [&](const char *type, const char *name, const unsigned int components,
+                             const auto &values) {
+        out << "<DataArray type=\"" << type << "\"" << (name[0] ? " Name=\"" : "") << name
+            << (name[0] ? "\"" : "") << " NumberOfComponents=\"" << components
+            << "\" format=\"binary\">\n";
+        Output::write_base64_array(out, values);
         out << "\n</DataArray>\n";
       };
+      array("Float64", "", 3, xyz);
+      out << "</Points>\n<Cells>\n";
+      array("Int64", "connectivity", 1, std::vector<std::int64_t>(connectivity.begin(), connectivity.end()));
+      array("Int64", "offsets", 1, std::vector<std::int64_t>(offsets.begin(), offsets.end()));
+      array("UInt8", "types", 1, std::vector<std::uint8_t>(types.begin(), types.end()));
+      out << "</Cells>\n<PointData Vectors=\"displacement\">\n";
+      std::vector<double> displacement_3d; // (u_x, u_y, 0)
+      displacement_3d.reserve(3 * points.size());
+      for (unsigned int k = 0; k < points.size(); ++k)
+        displacement_3d.insert(displacement_3d.end(), {displacement[2 * k], displacement[2 * k + 1], 0.0});
+      array("Float64", "displacement", 3, displacement_3d);
+      out << "</PointData>\n<CellData>\n";
+      const auto integers = [&](const char *name, const std::vector<int> &values) {
+        array("Int32", name, 1, std::vector<std::int32_t>(values.begin(), values.end()));
+      };
       const auto reals = [&](const char *name, const std::vector<double> &values) {
-        out << "<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
-        for (const auto x : values)
-          out << x << ' ';
-        out << "\n</DataArray>\n";
+        array("Float64", name, 1, values);
       };
       integers("cell", cell_index);
       integers("facet", facet_index);

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <iostream>
 #include <sstream>
 #include <vector>
@@ -237,13 +238,32 @@ namespace hysteron
     bool
     Model::solve_step(const double t, const double dt)
     {
+      if (const bool converged = newton_step(t, dt); converged || reuse_tolerance == 0)
+        return converged;
+      // Modified Newton failed (stale factors can overshoot where springs unload): the
+      // step again with a fresh factorization in every iteration.
+      const double tolerance = reuse_tolerance;
+      reuse_tolerance        = 0;
+      factorized             = false;
+      const bool converged   = newton_step(t, dt);
+      reuse_tolerance        = tolerance;
+      ++n_exact_retries;
+      return converged;
+    }
+
+
+
+    bool
+    Model::newton_step(const double t, const double dt)
+    {
       const double t1 = t + dt;
       spring_failure.clear();
       Vector du(u.size());
       // Predictor: the tangent of the converged state, the prescribed increments as
       // inhomogeneous constraints.
       make_constraints(t, t1, true);
-      u_trial = u;
+      u_trial           = u;
+      previous_residual = std::numeric_limits<double>::infinity(); // a new step's predictor
       // (Bouc-Wen springs keep the tangents of their last evaluation.)
       if (!assemble(t1, dt, true, analysis == Analysis::linear_static))
         return false;

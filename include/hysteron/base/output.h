@@ -28,6 +28,22 @@ namespace hysteron
      * committed (an exception, a failed run) is removed, so a reader never sees
      * a half-written output.
      */
+    /**
+     * The inline binary form of a VTK XML DataArray (format="binary", header_type="UInt64"):
+     * the base64 encoding of the array's byte count (8 bytes, little-endian) followed by
+     * its bytes.
+     */
+    void
+    write_base64(std::ostream &out, const void *data, std::size_t bytes);
+
+    /// write_base64() of the values of @p values (a contiguous container).
+    template <typename Container>
+    void
+    write_base64_array(std::ostream &out, const Container &values)
+    {
+      write_base64(out, values.data(), values.size() * sizeof(values[0]));
+    }
+
     class AtomicFile
     {
     public:

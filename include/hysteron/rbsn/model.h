@@ -210,6 +210,9 @@ namespace hysteron
       assemble(const double t1, const double dt, const bool matrix, const bool update_springs);
       bool
       solve_step(const double t, const double dt);
+      /// One attempt of solve_step(): predictor and Newton iterations.
+      bool
+      newton_step(const double t, const double dt);
       /// Accept the trial state of a step of @p dt (in which facets @p broke).
       void
       commit(const double dt, const bool broke);
@@ -308,6 +311,7 @@ namespace hysteron
       FractureParameters            fracture;
       VariableOrderParameters       variable_order;
       bool                          spring_table = false;
+      double                        reuse_tolerance = 0; ///< `Tangent reuse tolerance`
 
       // The network: cells (rigid bodies), facets (springs), bodies.
       Tessellation                          network;
@@ -324,6 +328,12 @@ namespace hysteron
       dealii::SparsityPattern           pattern;
       dealii::SparseMatrix<double>      matrix;
       dealii::SparseDirectUMFPACK       direct;
+      /// The matrix of the factors in `direct` (solve_linear() refactorizes on change).
+      dealii::SparseMatrix<double>      factored_matrix;
+      bool                              factorized = false, stale_factors = false;
+      double                            previous_residual = 0;
+      unsigned long                     n_factorizations  = 0;
+      unsigned long                     n_exact_retries   = 0; ///< steps modified Newton failed
       dealii::AffineConstraints<double> constraints;
       /// f_int, f_ext and inertia: the last evaluation (an iterate); f_ext_old and
       /// reaction_old (f_int + inertia - f_ext): the converged state, which the output reads.
