@@ -2,6 +2,7 @@
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 
 #include <hysteron/base/parameters.h>
+#include "base/sparse_lu.h"
 #include <hysteron/rbsn/model.h>
 #include <hysteron/scene/output_column.h>
 #include <hysteron/rbsn/rbsn.h>
@@ -136,6 +137,7 @@ namespace hysteron
     Model::Model(const Scene<2> &scene, const Methods::Interface<2> &method, dealii::ParameterHandler &prm)
       : scene(scene)
       , method(method)
+      , direct(std::make_unique<SparseLU>())
     {
       {
         Section s(prm, {"RBSN"});
@@ -205,6 +207,10 @@ namespace hysteron
                 "Boundary " + b.name + "/Type",
                 "the rbsn method has no walls (use fixed, roller, velocity or displacement)");
     }
+
+
+
+    Model::~Model() = default;
 
 
 
@@ -368,6 +374,7 @@ namespace hysteron
       matrix.reinit(pattern);
       factored_matrix.reinit(pattern);
       factorized = false;
+      direct->clear();
       for (Vector *w : {&u, &u_trial, &v, &a, &rhs, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
         w->reinit(n);
     }
@@ -624,7 +631,7 @@ namespace hysteron
         {
           if (!(change <= reuse_tolerance) || slow)
             {
-              direct.initialize(matrix);
+              direct->factorize(matrix);
               factored_matrix.copy_from(matrix);
               factorized = true;
               ++n_factorizations;
@@ -632,9 +639,9 @@ namespace hysteron
             }
           stale_factors     = change > 0;
           previous_residual = residual;
-          direct.vmult(x, rhs);
+          direct->solve(x, rhs);
         }
-      catch (const dealii::ExceptionBase &)
+      catch (const std::runtime_error &)
         {
           throw RuntimeError("rbsn: the stiffness matrix is singular: a part of the network is "
                              "not supported (fewer supports than rigid-body motions, or broken "

@@ -3,12 +3,14 @@
 #include <deal.II/sundials/ida.h>
 
 #include <hysteron/base/parameters.h>
+#include "base/sparse_lu.h"
 #include <hysteron/rbsn/model.h>
 #include <hysteron/run/stepping_method.h>
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 /*
  * Analysis = variable order: the state-space form of eq. 3.43-3.48 as an
@@ -166,7 +168,7 @@ namespace hysteron
       Vector                        reaction, f_ext;
       dealii::SparsityPattern       pattern;
       dealii::SparseMatrix<double>  jacobian;
-      dealii::SparseDirectUMFPACK   direct;
+      SparseLU                      direct; ///< the symbolic analysis kept over the Jacobians
 
       const Material::BoucWenUniaxial &
       law(const unsigned int e, const unsigned int i) const
@@ -479,9 +481,9 @@ namespace hysteron
         jacobian.add(j, j, cj);
       try
         {
-          direct.initialize(jacobian);
+          direct.factorize(jacobian);
         }
-      catch (const dealii::ExceptionBase &)
+      catch (const std::runtime_error &)
         {
           return -1; // singular: an unsupported network (IDA stops, run() reports it)
         }
@@ -493,7 +495,14 @@ namespace hysteron
     int
     Model::VariableOrder::solve(const Vector &rhs, Vector &x)
     {
-      direct.vmult(x, rhs);
+      try
+        {
+          direct.solve(x, rhs);
+        }
+      catch (const std::runtime_error &)
+        {
+          return 1; // recoverable: IDA retries with a smaller step
+        }
       return std::isfinite(x.l2_norm()) ? 0 : 1;
     }
 

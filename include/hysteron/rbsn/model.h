@@ -3,7 +3,6 @@
 
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/full_matrix.h>
-#include <deal.II/lac/sparse_direct.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/vector.h>
@@ -26,6 +25,8 @@
 
 namespace hysteron
 {
+  class SparseLU;
+
   namespace RBSN
   {
     enum class Analysis
@@ -100,6 +101,7 @@ namespace hysteron
     {
     public:
       Model(const Scene<2> &scene, const Methods::Interface<2> &method, dealii::ParameterHandler &prm);
+      ~Model();
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);
@@ -327,7 +329,7 @@ namespace hysteron
       // Linear algebra: 3 DoFs (u, v, theta) per cell.
       dealii::SparsityPattern           pattern;
       dealii::SparseMatrix<double>      matrix;
-      dealii::SparseDirectUMFPACK       direct;
+      std::unique_ptr<SparseLU>         direct; ///< UMFPACK, the symbolic analysis kept
       /// The matrix of the factors in `direct` (solve_linear() refactorizes on change).
       dealii::SparseMatrix<double>      factored_matrix;
       bool                              factorized = false, stale_factors = false;
