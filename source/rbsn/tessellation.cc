@@ -425,13 +425,15 @@ namespace hysteron
               }
         return false;
       };
-      // Up to @p trials random points in a square; the first one that is free is
-      // added and the front grows from it.
+      // Up to @p trials random points in a square (its part in the domain's box);
+      // the first one that is free is added and the front grows from it.
       const auto darts = [&](const double x0, const double y0, const double size, const unsigned int trials) {
-        for (unsigned int attempt = 0; attempt < trials; ++attempt)
+        const double ax = std::max(x0, box.first[0]), bx = std::min(x0 + size, box.second[0]);
+        const double ay = std::max(y0, box.first[1]), by = std::min(y0 + size, box.second[1]);
+        for (unsigned int attempt = 0; attempt < trials && ax <= bx && ay <= by; ++attempt)
           {
             const double u = uniform(rng), v = uniform(rng);
-            const Point  p(x0 + u * size, y0 + v * size);
+            const Point  p(ax + u * (bx - ax), ay + v * (by - ay));
             double       dp;
             if (free(p, dp))
               {
@@ -458,9 +460,12 @@ namespace hysteron
             }
       // The remaining gaps are slivers between exclusion disks: quarter every square
       // that is not covered (nor outside the domain at its corners and centre) and
-      // throw 10 darts into each quarter, for 4 levels, down to cells / 16 (as in
-      // the maximal Poisson-disk sampling of Ebeida et al., 2012).
-      for (unsigned int level = 0; level < 4 && !squares.empty(); ++level)
+      // throw 10 darts into each quarter, for 2 levels, down to cells / 4 (as in
+      // the maximal Poisson-disk sampling of Ebeida et al., 2012). Two levels give
+      // the density of the former sweeps of 20 darts per cell (0.68 A / d^2 and the
+      // boundary rows; doc/rbsn.md); more levels approach the jamming limit, 3 %
+      // denser.
+      for (unsigned int level = 0; level < 2 && !squares.empty(); ++level)
         {
           std::vector<std::array<double, 3>> quarters;
           for (const auto &q : squares)
