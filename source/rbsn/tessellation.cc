@@ -293,12 +293,13 @@ namespace hysteron
       require(std::isfinite(box.second[0] - box.first[0]) && std::isfinite(box.second[1] - box.first[1]),
               where,
               "the domain is unbounded");
-      // The background grid covers the domain's box and a margin of 2 d_max (the
-      // points there may exclude trials in the domain); cells of d_min / sqrt(2)
+      // The background grid covers the domain's box and a margin of 2 d_max, at
+      // most the box's size (the points there may exclude trials in the domain); cells of d_min / sqrt(2)
       // hold at most one random point each (larger cells if that grid would
       // exceed 4e7 cells: still exact, only slower). Points of the grid's cell
       // are listed from head[cell] through next[point].
-      const double margin = 2 * d.max;
+      const double margin =
+        std::min(2 * d.max, std::max(box.second[0] - box.first[0], box.second[1] - box.first[1]));
       const dealii::Tensor<1, 2> m({margin, margin});
       const Point                lo = box.first - m, hi = box.second + m;
       const double wx = hi[0] - lo[0], wy = hi[1] - lo[1];
