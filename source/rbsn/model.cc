@@ -8,8 +8,10 @@
 #include <hysteron/rbsn/rbsn.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <iomanip>
 #include <limits>
+#include <map>
 #include <sstream>
 
 namespace hysteron
@@ -24,10 +26,14 @@ namespace hysteron
       {
         prm.declare_entry("Minimum distance",
                           "0.05",
-                          Patterns::Double(),
+                          Patterns::Anything(),
                           "d_m [m] > 0: random nuclei keep at least this distance from each other "
                           "(Poisson-disk sampling up to saturation, about 0.68 A / d_m^2 points in "
-                          "an area A; dissertation §3.3.3).");
+                          "an area A; dissertation §3.3.3). A function of x, y gives a graded "
+                          "network (e.g. 0.002 + 0.02 * abs(x - 1), finer where d is smaller): a new "
+                          "point p keeps |p - q| >= min(d(p), d(q)) from every point q, about "
+                          "0.68 int 1/d^2 dA points; d must be finite and > 0 in the bodies and "
+                          "should vary slowly (|grad d| well below 1; doc/rbsn.md).");
         prm.declare_entry("Points on the boundary",
                           "true",
                           Patterns::Bool(),
@@ -43,7 +49,7 @@ namespace hysteron
                           "0",
                           Patterns::Double(),
                           "Segment length [m] of curved boundaries (disks as polygons), >= 0; 0: "
-                          "d_m / 4.");
+                          "d_m / 4 (the smallest d_m over the bodies for a graded network).");
         prm.declare_entry("Shear stiffness ratio",
                           "0",
                           Patterns::Double(),
@@ -141,12 +147,27 @@ namespace hysteron
     {
       {
         Section s(prm, {"RBSN"});
-        d_m                = s.get_positive("Minimum distance");
+        // A number is a constant d_m; anything else an expression in x and y,
+        // sampled over the bodies in build_network().
+        const std::string distance = dealii::Utilities::trim(s.get("Minimum distance"));
+        char             *end      = nullptr;
+        std::strtod(distance.c_str(), &end);
+        if (!distance.empty() && end == distance.c_str() + distance.size())
+          {
+            d_m     = s.get_positive("Minimum distance");
+            spacing = Spacing(d_m);
+          }
+        else
+          {
+            const std::shared_ptr<const dealii::FunctionParser<2>> d =
+              parse_function<2>(distance, "x,y", false, s.where("Minimum distance"));
+            spacing = Spacing([d](const dealii::Point<2> &p) { return d->value(p); },
+                              distance,
+                              s.where("Minimum distance"));
+          }
         points_on_boundary = s.get_bool("Points on the boundary");
         extra_points       = parse_points<2>(s.get("Additional points"), s.where("Additional points"));
-        boundary_h         = s.get_non_negative("Curved boundary resolution");
-        if (boundary_h == 0)
-          boundary_h = 0.25 * d_m;
+        boundary_h         = s.get_non_negative("Curved boundary resolution"); // 0: in build_network()
         shear_ratio  = s.get_non_negative("Shear stiffness ratio");
         moment_yield = s.get_positive("Moment yield factor");
         spring_law_name = s.get("Spring law");
@@ -218,6 +239,28 @@ namespace hysteron
     Model::build_network()
     {
       const auto &bodies = scene.body_descriptions();
+      // d over the bodies: its smallest value (d_m for the messages and the default
+      // resolution of curved boundaries) and the predicted number of points,
+      // 0.68 int 1/d^2 dA, which guards the memory and announces a long set-up.
+      spacing.sample(body_shapes);
+      d_m = spacing.min;
+      if (boundary_h == 0)
+        boundary_h = 0.25 * d_m;
+      std::ostringstream range;
+      if (spacing.is_constant())
+        range << "d_m = " << d_m;
+      else
+        range << "d = " << spacing.min << " ... " << spacing.max;
+      const std::string distance = range.str();
+      require(spacing.predicted_points <= 5e6,
+              "RBSN/Minimum distance",
+              "about " + std::to_string(static_cast<long>(spacing.predicted_points)) +
+                " points predicted at this minimum distance (0.68 int 1/d^2 dA over the bodies; at most 5e6)");
+      StageReport stage(scene.console(), spacing.predicted_points > 5e4);
+      if (stage.enabled())
+        scene.console() << "rbsn: about " << StageReport::count(static_cast<std::size_t>(spacing.predicted_points))
+                        << " cells predicted (0.68 int 1/d^2 dA, " << distance << " m)" << std::endl;
+
       // The nuclei: the user's points, points along every body's boundary, then
       // random points (one set for all bodies; each point belongs to the body
       // that contains it).
@@ -234,33 +277,39 @@ namespace hysteron
       if (points_on_boundary)
         for (const auto *shape : body_shapes)
           {
-            const auto p = boundary_points(*shape, d_m, boundary_h);
+            const auto p = boundary_points(*shape, spacing, boundary_h);
             fixed.insert(fixed.end(), p.begin(), p.end());
           }
-      // Merge points closer than 1e-6 d_m (corners shared by touching bodies).
-      std::vector<dealii::Point<2>> unique;
-      for (const auto &p : fixed)
-        {
-          bool seen = false;
-          for (const auto &q : unique)
-            seen = seen || p.distance(q) < 1e-6 * d_m;
-          if (!seen)
-            unique.push_back(p);
-        }
-      std::vector<dealii::Point<2>> points = unique;
-      // A saturated Poisson-disk set has about 0.68 A / d_m^2 points: say so when the
-      // set-up (sampling and Voronoi cells) will take noticeable time.
-      double area = 0;
-      for (const auto *shape : body_shapes)
-        area += shape->bounding_box().volume();
-      if (const double estimate = 0.68 * area / (d_m * d_m); estimate > 2e5)
-        scene.console() << "rbsn: placing up to about " << static_cast<long>(estimate)
-                        << " nuclei (d_m = " << d_m << " m) and their Voronoi cells; this set-up "
-                        << "takes a while" << std::endl;
+      // Merge points closer than 1e-6 d_m (corners shared by touching bodies), the
+      // first kept: each point is compared with the kept ones in its and the
+      // neighbouring cells of a hash grid of that size.
+      std::vector<dealii::Point<2>> points;
+      {
+        const double tolerance = 1e-6 * d_m;
+        const auto   key       = [&](const dealii::Point<2> &p, const int dx, const int dy) {
+          return std::make_pair(static_cast<long long>(std::floor(p[0] / tolerance)) + dx,
+                                static_cast<long long>(std::floor(p[1] / tolerance)) + dy);
+        };
+        std::map<std::pair<long long, long long>, std::vector<unsigned int>> kept;
+        for (const auto &p : fixed)
+          {
+            bool seen = false;
+            for (int dy = -1; dy <= 1 && !seen; ++dy)
+              for (int dx = -1; dx <= 1 && !seen; ++dx)
+                if (const auto k = kept.find(key(p, dx, dy)); k != kept.end())
+                  for (const unsigned int q : k->second)
+                    seen = seen || p.distance(points[q]) < tolerance;
+            if (!seen)
+              {
+                kept[key(p, 0, 0)].push_back(points.size());
+                points.push_back(p);
+              }
+          }
+      }
       for (unsigned int s = 0; s < body_shapes.size(); ++s)
         {
-          // Each body is filled in turn, keeping d_m from every point so far.
-          auto filled = poisson_disk_points(*body_shapes[s], d_m, points,
+          // Each body is filled in turn, keeping the distance from every point so far.
+          auto filled = poisson_disk_points(*body_shapes[s], spacing, points,
                                             scene.random_seed() + 7919 * s, "RBSN/Minimum distance");
           points.swap(filled);
         }
@@ -268,8 +317,10 @@ namespace hysteron
               "RBSN/Minimum distance",
               "leaves room for " + std::to_string(points.size()) +
                 " nucleus in the bodies, and a network needs at least two cells: the minimum "
-                "distance must be well below the size of the bodies (got " + std::to_string(d_m) + " m)");
+                "distance must be well below the size of the bodies (got " + distance + " m)");
+      stage(StageReport::count(points.size()) + " nuclei");
       network = voronoi(points, body_shapes, boundary_h, "Body names");
+      stage("Voronoi cells");
 
       // The bodies and the rigid-body mass properties about the nuclei (eq. 3.12).
       const unsigned int n = network.cells.size();

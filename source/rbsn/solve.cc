@@ -452,16 +452,24 @@ namespace hysteron
     void
     Model::setup()
     {
+      // A large network reports each stage (build_network(): nuclei and cells).
       build_network();
+      StageReport stage(scene.console(), spacing.predicted_points > 5e4);
       setup_springs();
+      stage(StageReport::count(network.facets.size()) + " facets' springs");
       setup_system();
+      stage("sparsity pattern of " + StageReport::count(3 * network.cells.size()) + " DoFs");
       setup_conditions();
       check_supports();
       update_fragments();
       locate_probes();
-      scene.console() << "rbsn: " << network.cells.size() << " cells, " << network.facets.size()
-                      << " facets (d_m = " << d_m << " m), " << 3 * network.cells.size() << " DoFs"
-                      << std::endl;
+      stage("supports, loads and probes");
+      scene.console() << "rbsn: " << network.cells.size() << " cells, " << network.facets.size() << " facets (";
+      if (spacing.is_constant())
+        scene.console() << "d_m = " << d_m;
+      else
+        scene.console() << "d = " << spacing.min << " ... " << spacing.max;
+      scene.console() << " m), " << 3 * network.cells.size() << " DoFs" << std::endl;
       if ((analysis == Analysis::quasi_static || analysis == Analysis::implicit_dynamics) &&
           !consistent_tangent && scene.is_root())
         std::cerr << "hysteron: warning: RBSN: the springs' tangent is not the algorithmic one "

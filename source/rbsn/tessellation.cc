@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <map>
 #include <random>
 #include <sstream>
@@ -175,6 +176,98 @@ namespace hysteron
 
 
 
+    Spacing::Spacing(const double d_m)
+      : min(d_m)
+      , max(d_m)
+    {}
+
+
+
+    Spacing::Spacing(std::function<double(const dealii::Point<2> &)> function,
+                     const std::string                              &expression,
+                     const std::string                              &where)
+      : function(std::move(function))
+      , expression(expression)
+      , where(where)
+    {}
+
+
+
+    double
+    Spacing::operator()(const dealii::Point<2> &p) const
+    {
+      if (!function)
+        return min;
+      const double d = function(p);
+      if (!(d > 0) || !std::isfinite(d))
+        {
+          std::ostringstream s;
+          s.precision(6);
+          s << "the expression '" << expression << "' evaluates to " << d << " at x = " << p[0]
+            << ", y = " << p[1] << ": the minimum distance must be > 0 in the bodies";
+          throw InputError(where, s.str());
+        }
+      return d;
+    }
+
+
+
+    void
+    Spacing::sample(const std::vector<const Geometry::Region<2> *> &bodies)
+    {
+      Point lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max()), hi = -lo;
+      for (const auto *b : bodies)
+        {
+          const auto box = b->bounding_box().get_boundary_points();
+          for (unsigned int k = 0; k < 2; ++k)
+            {
+              lo[k] = std::min(lo[k], box.first[k]);
+              hi[k] = std::max(hi[k], box.second[k]);
+            }
+        }
+      const double wx = hi[0] - lo[0], wy = hi[1] - lo[1];
+      if (!(wx > 0 && wy > 0 && std::isfinite(wx * wy)))
+        return; // unbounded or degenerate: poisson_disk_points() says so
+      // Square cells, about 2^16 of them.
+      const double       h  = std::sqrt(wx * wy / 65536.0);
+      const unsigned int nx = std::max(1, static_cast<int>(std::ceil(wx / h))),
+                         ny = std::max(1, static_cast<int>(std::ceil(wy / h)));
+      const double       hx = wx / nx, hy = wy / ny;
+      std::vector<double> value(static_cast<std::size_t>(nx) * ny, 0.0); // 0: outside
+      double              integral = 0, smallest = std::numeric_limits<double>::max(), largest = 0;
+      for (unsigned int j = 0; j < ny; ++j)
+        for (unsigned int i = 0; i < nx; ++i)
+          {
+            const Point x(lo[0] + (i + 0.5) * hx, lo[1] + (j + 0.5) * hy);
+            if (std::none_of(bodies.begin(), bodies.end(), [&](const auto *b) { return b->contains(x); }))
+              continue;
+            const double d                              = (*this)(x);
+            value[static_cast<std::size_t>(j) * nx + i] = d;
+            integral += hx * hy / (d * d);
+            smallest = std::min(smallest, d);
+            largest  = std::max(largest, d);
+          }
+      predicted_points = 0.68 * integral;
+      if (function && largest > 0)
+        {
+          min = smallest;
+          max = largest;
+          // |grad d| from the differences of neighbouring samples in the bodies.
+          gradient = 0;
+          for (unsigned int j = 0; j < ny; ++j)
+            for (unsigned int i = 0; i < nx; ++i)
+              if (const double d = value[static_cast<std::size_t>(j) * nx + i]; d > 0)
+                {
+                  if (i + 1 < nx && value[static_cast<std::size_t>(j) * nx + i + 1] > 0)
+                    gradient = std::max(gradient, std::abs(value[static_cast<std::size_t>(j) * nx + i + 1] - d) / hx);
+                  if (j + 1 < ny && value[static_cast<std::size_t>(j + 1) * nx + i] > 0)
+                    gradient = std::max(gradient, std::abs(value[static_cast<std::size_t>(j + 1) * nx + i] - d) / hy);
+                }
+        }
+    }
+
+
+
     std::vector<dealii::Point<2>>
     poisson_disk_points(const Geometry::Region<2>           &domain,
                         const double                         d_m,
@@ -183,99 +276,226 @@ namespace hysteron
                         const std::string                   &where)
     {
       require(d_m > 0 && std::isfinite(d_m), where, "the minimum distance must be > 0");
-      const auto   box = domain.bounding_box();
-      const Point  lo  = box.get_boundary_points().first, hi = box.get_boundary_points().second;
-      const double wx = hi[0] - lo[0], wy = hi[1] - lo[1];
-      require(std::isfinite(wx) && std::isfinite(wy), where, "the domain is unbounded");
-      require(0.7 * wx * wy / (d_m * d_m) <= 5e6,
-              where,
-              "about " + std::to_string(static_cast<long>(0.7 * wx * wy / (d_m * d_m))) +
-                " points at this minimum distance (at most 5e6)");
-
-      // Background grid of cells d_m / sqrt(2): at most one random point per cell.
-      const double cell = d_m / std::sqrt(2.0);
-      const int    nx = std::max(1, static_cast<int>(std::ceil(wx / cell))),
-                ny = std::max(1, static_cast<int>(std::ceil(wy / cell)));
-      std::vector<std::vector<unsigned int>> grid(static_cast<std::size_t>(nx) * ny);
-      const auto                             index = [&](const Point &p) {
-        const int i = std::clamp(static_cast<int>((p[0] - lo[0]) / cell), 0, nx - 1);
-        const int j = std::clamp(static_cast<int>((p[1] - lo[1]) / cell), 0, ny - 1);
-        return std::make_pair(i, j);
-      };
-      std::vector<Point> points;
-      const auto         add = [&](const Point &p) {
-        const auto [i, j] = index(p);
-        grid[static_cast<std::size_t>(j) * nx + i].push_back(points.size());
-        points.push_back(p);
-      };
-      const auto free = [&](const Point &p) {
-        if (!domain.contains(p))
-          return false;
-        const auto [i, j] = index(p);
-        for (int b = std::max(0, j - 2); b <= std::min(ny - 1, j + 2); ++b)
-          for (int a = std::max(0, i - 2); a <= std::min(nx - 1, i + 2); ++a)
-            for (const unsigned int k : grid[static_cast<std::size_t>(b) * nx + a])
-              if (points[k].distance(p) < d_m)
-                return false;
-        return true;
-      };
-      for (const auto &p : fixed)
-        add(p);
-
-      // Bridson: grow from active points by trial points in the annulus [d_m, 2 d_m];
-      // when the front dies out, look for a free spot anywhere (other components,
-      // the first seed), and stop when a sweep of random trials finds none.
-      std::mt19937_64           rng(seed);
-      std::vector<unsigned int> active;
-      for (unsigned int k = 0; k < points.size(); ++k)
-        active.push_back(k);
-      const unsigned int sweep = std::max<unsigned int>(1000, 20 * nx * ny);
-      while (true)
-        {
-          while (!active.empty())
-            {
-              const unsigned int pick = static_cast<unsigned int>(uniform(rng) * active.size());
-              const Point        c    = points[active[pick]];
-              bool               grew = false;
-              for (unsigned int attempt = 0; attempt < 30; ++attempt)
-                {
-                  const double r = d_m * (1 + uniform(rng)), phi = 2 * M_PI * uniform(rng);
-                  const Point  p(c[0] + r * std::cos(phi), c[1] + r * std::sin(phi));
-                  if (free(p))
-                    {
-                      active.push_back(points.size());
-                      add(p);
-                      grew = true;
-                      break;
-                    }
-                }
-              if (!grew)
-                {
-                  active[pick] = active.back();
-                  active.pop_back();
-                }
-            }
-          bool found = false;
-          for (unsigned int attempt = 0; attempt < sweep && !found; ++attempt)
-            {
-              const Point p(lo[0] + wx * uniform(rng), lo[1] + wy * uniform(rng));
-              if (free(p))
-                {
-                  active.push_back(points.size());
-                  add(p);
-                  found = true;
-                }
-            }
-          if (!found)
-            break;
-        }
-      return points;
+      return poisson_disk_points(domain, Spacing(d_m), fixed, seed, where);
     }
 
 
 
     std::vector<dealii::Point<2>>
-    boundary_points(const Geometry::Region<2> &domain, const double spacing, const double boundary_h)
+    poisson_disk_points(const Geometry::Region<2>           &domain,
+                        const Spacing                       &d,
+                        const std::vector<dealii::Point<2>> &fixed,
+                        const std::uint64_t                  seed,
+                        const std::string                   &where)
+    {
+      require(d.min > 0 && d.max >= d.min, where, "the minimum distance must be > 0");
+      const auto box = domain.bounding_box().get_boundary_points();
+      require(std::isfinite(box.second[0] - box.first[0]) && std::isfinite(box.second[1] - box.first[1]),
+              where,
+              "the domain is unbounded");
+      // The background grid covers the domain's box and a margin of 2 d_max, at
+      // most the box's size (the points there may exclude trials in the domain); cells of d_min / sqrt(2)
+      // hold at most one random point each (larger cells if that grid would
+      // exceed 4e7 cells: still exact, only slower). Points of the grid's cell
+      // are listed from head[cell] through next[point].
+      const double margin =
+        std::min(2 * d.max, std::max(box.second[0] - box.first[0], box.second[1] - box.first[1]));
+      const dealii::Tensor<1, 2> m({margin, margin});
+      const Point                lo = box.first - m, hi = box.second + m;
+      const double wx = hi[0] - lo[0], wy = hi[1] - lo[1];
+      const double cell = std::max(d.min / std::sqrt(2.0), std::sqrt(wx * wy / 4e7));
+      const int    nx = std::max(1, static_cast<int>(std::ceil(wx / cell))),
+                ny = std::max(1, static_cast<int>(std::ceil(wy / cell)));
+      std::vector<int> head(static_cast<std::size_t>(nx) * ny, -1), next;
+      // covered[c]: every trial in grid cell c is refused (see add()).
+      std::vector<bool>   covered(head.size(), false);
+      std::vector<Point>  points;
+      std::vector<double> radius; // d at each point
+      // Fixed points beyond the margin: far from every trial unless d is far
+      // above its sampled maximum, when they are checked one by one.
+      std::vector<Point> far;
+      const auto         column = [&](const double x) {
+        return std::clamp(static_cast<int>(std::floor((x - lo[0]) / cell)), 0, nx - 1);
+      };
+      const auto row = [&](const double y) {
+        return std::clamp(static_cast<int>(std::floor((y - lo[1]) / cell)), 0, ny - 1);
+      };
+      const auto in_grid = [&](const Point &p) {
+        return p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1];
+      };
+      // A trial p is refused by q if |p - q| < min(d(p), d(q)). With |grad d| <= L,
+      // d(p) >= d(q) - L |p - q|, so every p with |p - q| < R = d(q) / (1 + L) is
+      // refused: the grid cells inside that disk of q are covered.
+      const double shrink = 1 / (1 + d.gradient);
+      const auto   add    = [&](const Point &p, const double dp) {
+        const int i = column(p[0]), j = row(p[1]);
+        const std::size_t c = static_cast<std::size_t>(j) * nx + i;
+        next.push_back(head[c]);
+        head[c] = static_cast<int>(points.size());
+        points.push_back(p);
+        radius.push_back(dp);
+        const double R = dp * shrink;
+        const int    reach = static_cast<int>(std::ceil(R / cell));
+        for (int b = std::max(0, j - reach); b <= std::min(ny - 1, j + reach); ++b)
+          for (int a = std::max(0, i - reach); a <= std::min(nx - 1, i + reach); ++a)
+            {
+              // The corner of the cell farthest from p.
+              const double x0 = lo[0] + a * cell, y0 = lo[1] + b * cell;
+              const double fx = std::max(std::abs(x0 - p[0]), std::abs(x0 + cell - p[0]));
+              const double fy = std::max(std::abs(y0 - p[1]), std::abs(y0 + cell - p[1]));
+              if (fx * fx + fy * fy < R * R)
+                covered[static_cast<std::size_t>(b) * nx + a] = true;
+            }
+      };
+      // Whether p may be added, and d(p) if so.
+      const auto free = [&](const Point &p, double &dp) {
+        if (!in_grid(p) || covered[static_cast<std::size_t>(row(p[1])) * nx + column(p[0])] || !domain.contains(p))
+          return false;
+        dp              = d(p);
+        const int i     = column(p[0]), j = row(p[1]);
+        const int reach = static_cast<int>(std::ceil(dp / cell));
+        for (int b = std::max(0, j - reach); b <= std::min(ny - 1, j + reach); ++b)
+          for (int a = std::max(0, i - reach); a <= std::min(nx - 1, i + reach); ++a)
+            for (int k = head[static_cast<std::size_t>(b) * nx + a]; k >= 0; k = next[k])
+              if (points[k].distance(p) < std::min(dp, radius[k]))
+                return false;
+        if (dp > margin)
+          for (const auto &q : far)
+            if (q.distance(p) < dp) // d(q) is not needed: the stricter test
+              return false;
+        return true;
+      };
+
+      // The fixed points: in the grid (and the front) if within the margin.
+      std::vector<unsigned int> active;
+      std::vector<Point>        result;
+      for (const auto &p : fixed)
+        if (in_grid(p))
+          {
+            active.push_back(points.size());
+            add(p, d(p));
+          }
+        else
+          far.push_back(p);
+
+      // Bridson: grow from active points by trial points in the annulus [d, 2 d]
+      // around them until the front dies out.
+      std::mt19937_64 rng(seed);
+      const auto      grow = [&]() {
+        while (!active.empty())
+          {
+            const unsigned int pick = static_cast<unsigned int>(uniform(rng) * active.size());
+            const Point        c    = points[active[pick]];
+            const double       dc   = radius[active[pick]];
+            bool               grew = false;
+            for (unsigned int attempt = 0; attempt < 30 && !grew; ++attempt)
+              {
+                const double r = dc * (1 + uniform(rng)), phi = 2 * M_PI * uniform(rng);
+                const Point  p(c[0] + r * std::cos(phi), c[1] + r * std::sin(phi));
+                double       dp;
+                if (free(p, dp))
+                  {
+                    active.push_back(points.size());
+                    add(p, dp);
+                    result.push_back(p);
+                    grew = true;
+                  }
+              }
+            if (!grew)
+              {
+                active[pick] = active.back();
+                active.pop_back();
+              }
+          }
+      };
+      grow();
+      // A square [x0, x0 + size] x [y0, y0 + size] in which every trial is refused
+      // because one point's disk of radius d(q) / (1 + L) holds its four corners.
+      const int  square_reach = static_cast<int>(std::ceil(d.max * shrink / cell));
+      const auto square_covered = [&](const double x0, const double y0, const double size) {
+        const int i = column(x0 + 0.5 * size), j = row(y0 + 0.5 * size);
+        for (int b = std::max(0, j - square_reach - 1); b <= std::min(ny - 1, j + square_reach + 1); ++b)
+          for (int a = std::max(0, i - square_reach - 1); a <= std::min(nx - 1, i + square_reach + 1); ++a)
+            for (int k = head[static_cast<std::size_t>(b) * nx + a]; k >= 0; k = next[k])
+              {
+                const double fx = std::max(std::abs(x0 - points[k][0]), std::abs(x0 + size - points[k][0]));
+                const double fy = std::max(std::abs(y0 - points[k][1]), std::abs(y0 + size - points[k][1]));
+                const double R  = radius[k] * shrink;
+                if (fx * fx + fy * fy < R * R)
+                  return true;
+              }
+        return false;
+      };
+      // Up to @p trials random points in a square (its part in the domain's box);
+      // the first one that is free is added and the front grows from it.
+      const auto darts = [&](const double x0, const double y0, const double size, const unsigned int trials) {
+        const double ax = std::max(x0, box.first[0]), bx = std::min(x0 + size, box.second[0]);
+        const double ay = std::max(y0, box.first[1]), by = std::min(y0 + size, box.second[1]);
+        for (unsigned int attempt = 0; attempt < trials && ax <= bx && ay <= by; ++attempt)
+          {
+            const double u = uniform(rng), v = uniform(rng);
+            const Point  p(ax + u * (bx - ax), ay + v * (by - ay));
+            double       dp;
+            if (free(p, dp))
+              {
+                active.push_back(points.size());
+                add(p, dp);
+                result.push_back(p);
+                grow();
+                return;
+              }
+          }
+      };
+      // The gaps the front left (other components, the first seed, corners): 30
+      // trials in every grid cell that no exclusion disk covers, in a fixed order,
+      // and the front again from each point found. Points only cover more, so one
+      // pass visits each cell once.
+      std::vector<std::array<double, 3>> squares; // x0, y0, size: the gaps left
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i)
+          if (!covered[static_cast<std::size_t>(j) * nx + i])
+            {
+              darts(lo[0] + i * cell, lo[1] + j * cell, cell, 30);
+              if (!covered[static_cast<std::size_t>(j) * nx + i])
+                squares.push_back({{lo[0] + i * cell, lo[1] + j * cell, cell}});
+            }
+      // The remaining gaps are slivers between exclusion disks: quarter every square
+      // that is not covered (nor outside the domain at its corners and centre) and
+      // throw 10 darts into each quarter, for 2 levels, down to cells / 4 (as in
+      // the maximal Poisson-disk sampling of Ebeida et al., 2012). Two levels give
+      // the density of the former sweeps of 20 darts per cell (0.68 A / d^2 and the
+      // boundary rows; doc/rbsn.md); more levels approach the jamming limit, 3 %
+      // denser.
+      for (unsigned int level = 0; level < 2 && !squares.empty(); ++level)
+        {
+          std::vector<std::array<double, 3>> quarters;
+          for (const auto &q : squares)
+            for (unsigned int c = 0; c < 4; ++c)
+              {
+                const double h = 0.5 * q[2], x0 = q[0] + (c % 2) * h, y0 = q[1] + (c / 2) * h;
+                const bool   inside = domain.contains(Point(x0 + 0.5 * h, y0 + 0.5 * h)) ||
+                                    domain.contains(Point(x0, y0)) || domain.contains(Point(x0 + h, y0)) ||
+                                    domain.contains(Point(x0, y0 + h)) || domain.contains(Point(x0 + h, y0 + h));
+                if (inside && !square_covered(x0, y0, h))
+                  quarters.push_back({{x0, y0, h}});
+              }
+          squares.clear();
+          for (const auto &q : quarters)
+            if (!square_covered(q[0], q[1], q[2]))
+              {
+                darts(q[0], q[1], q[2], 10);
+                if (!square_covered(q[0], q[1], q[2]))
+                  squares.push_back(q);
+              }
+        }
+      result.insert(result.begin(), fixed.begin(), fixed.end());
+      return result;
+    }
+
+
+
+    std::vector<dealii::Point<2>>
+    boundary_points(const Geometry::Region<2> &domain, const Spacing &spacing, const double boundary_h)
     {
       const auto   box   = domain.bounding_box().get_boundary_points();
       const double scale = box.first.distance(box.second);
@@ -286,7 +506,8 @@ namespace hysteron
       for (const auto &loop : loops)
         {
           // Corners (a turn of more than 20 degrees) are kept; between corners the
-          // points are spread evenly by arc length.
+          // points are spread evenly in tau(s) = int_0^s ds / d, the arc length in
+          // units of the local d (s / d_m for a constant d).
           const unsigned int        n = loop.size();
           std::vector<unsigned int> corners;
           for (unsigned int k = 0; k < n; ++k)
@@ -310,13 +531,45 @@ namespace hysteron
               double length = 0;
               for (unsigned int k = 0; k + 1 < path.size(); ++k)
                 length += path[k].distance(path[k + 1]);
-              const unsigned int pieces = std::max(1u, static_cast<unsigned int>(std::ceil(length / spacing - 1e-9)));
-              // Points at arc lengths j * length / pieces, j = 0 .. pieces - 1 (the next run adds its corner).
+              // tau tabulated at arc lengths s (midpoint rule, steps of at most d / 4).
+              std::vector<double> s_table{0.0}, tau_table{0.0};
+              if (spacing.is_constant())
+                {
+                  s_table.push_back(length);
+                  tau_table.push_back(length / spacing.min);
+                }
+              else
+                for (unsigned int k = 0; k + 1 < path.size(); ++k)
+                  {
+                    const double               seg = path[k].distance(path[k + 1]);
+                    const dealii::Tensor<1, 2> r   = path[k + 1] - path[k];
+                    const double               s0  = s_table.back();
+                    for (double t = 0; t < seg;)
+                      {
+                        const double step = std::min(seg - t, 0.25 * spacing(path[k] + (t / seg) * r));
+                        const double tau  = step / spacing(path[k] + ((t + 0.5 * step) / seg) * r);
+                        t                 = step < seg - t ? t + step : seg;
+                        s_table.push_back(s0 + t);
+                        tau_table.push_back(tau_table.back() + tau);
+                      }
+                  }
+              const double       total  = tau_table.back();
+              const unsigned int pieces = std::max(1u, static_cast<unsigned int>(std::ceil(total - 1e-9)));
+              // Points at tau = j total / pieces, j = 0 .. pieces - 1 (the next run adds its corner),
+              // so that neighbours are at most the local d apart.
               double       walked = 0;
-              unsigned int k      = 0;
+              unsigned int k      = 0, m = 0;
               for (unsigned int j = 0; j < pieces; ++j)
                 {
-                  const double target = j * length / pieces;
+                  double target = j * length / pieces;
+                  if (!spacing.is_constant())
+                    {
+                      const double tau = j * total / pieces;
+                      while (m + 2 < tau_table.size() && tau_table[m + 1] < tau)
+                        ++m;
+                      const double dt = tau_table[m + 1] - tau_table[m];
+                      target = s_table[m] + (dt > 0 ? (tau - tau_table[m]) / dt : 0.0) * (s_table[m + 1] - s_table[m]);
+                    }
                   while (k + 1 < path.size() - 1 && walked + path[k].distance(path[k + 1]) < target)
                     walked += path[k].distance(path[k + 1]), ++k;
                   const double seg = path[k].distance(path[k + 1]);
@@ -365,6 +618,28 @@ namespace hysteron
       for (const auto &p : nuclei)
         require(in_domain(p, 1e-9 * scale), where, "the point " + text(p) + " lies outside the bodies");
       const std::vector<Segment> boundary = oriented_boundary(domain, boundary_h, scale);
+      // The boundary segments in buckets of about two cells' size over the box, so
+      // that a cell meets only the segments near it.
+      const double bucket = std::max(2 * std::sqrt((hi[0] - lo[0]) * (hi[1] - lo[1]) / nuclei.size()), 1e-3 * scale);
+      const int    bx     = std::max(1, static_cast<int>(std::ceil((hi[0] - lo[0]) / bucket))),
+                by     = std::max(1, static_cast<int>(std::ceil((hi[1] - lo[1]) / bucket)));
+      const auto bucket_range = [&](const Point &a, const Point &b) {
+        const auto at = [&](const double x, const double origin, const int n) {
+          return std::clamp(static_cast<int>(std::floor((x - origin) / bucket)), 0, n - 1);
+        };
+        return std::array<int, 4>{{at(a[0], lo[0], bx), at(b[0], lo[0], bx), at(a[1], lo[1], by), at(b[1], lo[1], by)}};
+      };
+      std::vector<std::vector<unsigned int>> buckets(static_cast<std::size_t>(bx) * by);
+      for (unsigned int k = 0; k < boundary.size(); ++k)
+        {
+          const Point a(std::min(boundary[k][0][0], boundary[k][1][0]), std::min(boundary[k][0][1], boundary[k][1][1]));
+          const Point b(std::max(boundary[k][0][0], boundary[k][1][0]), std::max(boundary[k][0][1], boundary[k][1][1]));
+          const auto  r = bucket_range(a, b);
+          for (int y = r[2]; y <= r[3]; ++y)
+            for (int x = r[0]; x <= r[1]; ++x)
+              buckets[static_cast<std::size_t>(y) * bx + x].push_back(k);
+        }
+      std::vector<unsigned int> seen(boundary.size(), 0);
 
       // The Delaunay triangulation gives every cell's Voronoi neighbours.
       DT dt;
@@ -460,6 +735,32 @@ namespace hysteron
             tag.swap(kept_tag);
           }
 
+          // The boundary segments whose buckets meet the cell's box (in their
+          // order). A cell that meets none lies in the domain: its nucleus does.
+          std::vector<Segment> near;
+          {
+            Point a = poly[0], b = poly[0];
+            for (const auto &p : poly)
+              for (unsigned int d = 0; d < 2; ++d)
+                {
+                  a[d] = std::min(a[d], p[d] - 2 * eps);
+                  b[d] = std::max(b[d], p[d] + 2 * eps);
+                }
+            const auto                r = bucket_range(a, b);
+            std::vector<unsigned int> found;
+            for (int y = r[2]; y <= r[3]; ++y)
+              for (int x = r[0]; x <= r[1]; ++x)
+                for (const unsigned int k : buckets[static_cast<std::size_t>(y) * bx + x])
+                  if (seen[k] != i + 1)
+                    {
+                      seen[k] = i + 1;
+                      found.push_back(k);
+                    }
+            std::sort(found.begin(), found.end());
+            for (const unsigned int k : found)
+              near.push_back(boundary[k]);
+          }
+
           // The boundary of cell and domain: the cell's edges inside the domain,
           // and the domain's boundary inside the cell.
           std::vector<Segment> pieces;
@@ -469,7 +770,7 @@ namespace hysteron
             {
               const Point &p = poly[k], &q = poly[(k + 1) % m];
               std::vector<double> cuts{0.0, 1.0};
-              for (const auto &s : boundary)
+              for (const auto &s : near)
                 {
                   double a, b;
                   if (intersect(p, q, s[0], s[1], a, b))
@@ -483,7 +784,7 @@ namespace hysteron
                   if (cuts[c + 1] - cuts[c] < 1e-12)
                     continue;
                   const Point a = p + cuts[c] * r, b = p + cuts[c + 1] * r;
-                  if (!in_domain(0.5 * (a + b) + eps * left, 0.0))
+                  if (!near.empty() && !in_domain(0.5 * (a + b) + eps * left, 0.0))
                     continue;
                   pieces.push_back(Segment{{a, b}});
                   moments.add(a, b);
@@ -491,7 +792,7 @@ namespace hysteron
                     facet_pieces[{i, static_cast<unsigned int>(tag[k])}].push_back(Segment{{a, b}});
                 }
             }
-          for (const auto &s : boundary)
+          for (const auto &s : near)
             {
               // Cyrus-Beck: the part of s inside the convex cell.
               double t0 = 0, t1 = 1;
@@ -571,6 +872,42 @@ namespace hysteron
           result.facets.push_back(f);
         }
       return result;
+    }
+
+
+
+    StageReport::StageReport(const dealii::ConditionalOStream &console, const bool enabled)
+      : console(console)
+      , on(enabled)
+    {}
+
+
+
+    void
+    StageReport::operator()(const std::string &what)
+    {
+      if (on)
+        {
+          std::ostringstream line;
+          line << "rbsn: " << what << " in " << std::fixed << std::setprecision(1) << clock.wall_time() << " s";
+          console << line.str() << std::endl;
+        }
+      clock.restart();
+    }
+
+
+
+    std::string
+    StageReport::count(const std::size_t n)
+    {
+      std::string digits = std::to_string(n), grouped;
+      for (std::size_t k = 0; k < digits.size(); ++k)
+        {
+          if (k > 0 && (digits.size() - k) % 3 == 0)
+            grouped += ',';
+          grouped += digits[k];
+        }
+      return grouped;
     }
   } // namespace RBSN
 } // namespace hysteron

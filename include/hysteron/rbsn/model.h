@@ -297,10 +297,11 @@ namespace hysteron
       const Methods::Interface<2> &method;
 
       // Parameters.
-      double                        d_m = 0;
+      Spacing                       spacing; ///< `Minimum distance` d(x), sampled by build_network()
+      double                        d_m = 0; ///< the constant d_m, or the smallest d of a function
       bool                          points_on_boundary = true;
       std::vector<dealii::Point<2>> extra_points;
-      double                        boundary_h   = 0;
+      double                        boundary_h   = 0; ///< 0 until build_network(): d_m / 4
       double                        shear_ratio  = 0;
       double                        moment_yield = 0.25;
       std::string                   spring_law_name;

@@ -1,13 +1,16 @@
 #ifndef hysteron_rbsn_tessellation_h
 #define hysteron_rbsn_tessellation_h
 
+#include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/point.h>
 #include <deal.II/base/tensor.h>
+#include <deal.II/base/timer.h>
 
 #include <hysteron/geometry/region.h>
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,16 +23,76 @@ namespace hysteron
   namespace RBSN
   {
     /**
-     * Nuclei for the Voronoi cells: the @p fixed points first (user points, points
-     * along the boundary; kept as given), then random points in @p domain with a
-     * minimum distance @p d_m to every other point, added until the domain is
-     * saturated (Bridson's Poisson-disk sampling, seeded: the same seed gives the
-     * same points). A saturated random sequential addition approaches
-     * n = 0.68 A / d_m^2 points in an area A (Bolander & Saito; dissertation §3.3.3).
-     * Fixed points closer than d_m to each other are kept; random ones keep d_m
-     * from all. Throws InputError(@p where) for d_m <= 0 or an estimate of more
-     * than 5e6 points.
+     * The minimum distance of the nuclei, d(x) > 0 (`RBSN/Minimum distance`): a
+     * constant d_m, or a function of the point for a graded network (finer where
+     * d is smaller). sample() evaluates it over the bodies for its bounds, its
+     * gradient and the predicted number of points.
      */
+    class Spacing
+    {
+    public:
+      /// A constant d_m (not checked here: the parameter is read as a positive number).
+      Spacing(const double d_m = 0);
+
+      /// d(x) from @p function; @p expression and @p where name it in errors.
+      Spacing(std::function<double(const dealii::Point<2> &)> function,
+              const std::string                              &expression,
+              const std::string                              &where);
+
+      /// d(p); throws InputError(where) naming the expression and p unless d(p) > 0 and finite.
+      double
+      operator()(const dealii::Point<2> &p) const;
+
+      bool
+      is_constant() const
+      {
+        return !function;
+      }
+
+      /**
+       * Evaluate d at the midpoints of a grid of about 2^16 square cells over the
+       * bounding box of @p bodies (the points in a body): the bounds of d, its
+       * largest gradient (finite differences of neighbouring samples) and the
+       * predicted number of points of a saturated set, 0.68 int 1/d^2 dA
+       * (midpoint rule; exact for a constant d up to the area's estimate).
+       */
+      void
+      sample(const std::vector<const Geometry::Region<2> *> &bodies);
+
+      /// The smallest and largest d over the bodies (sampled; the constant).
+      double min = 0, max = 0;
+      /// The largest |grad d| over the bodies (sampled; 0 for a constant).
+      double gradient = 0;
+      /// 0.68 int 1/d^2 dA over the bodies (after sample()).
+      double predicted_points = 0;
+
+    private:
+      std::function<double(const dealii::Point<2> &)> function;
+      std::string                                     expression, where;
+    };
+
+    /**
+     * Nuclei for the Voronoi cells: the @p fixed points first (user points, points
+     * along the boundary; kept as given), then random points in @p domain added
+     * until it is saturated, each keeping |p - q| >= min(d(p), d(q)) from every
+     * point q (Poisson-disk sampling, seeded: the same seed gives the same
+     * points). A saturated random sequential addition approaches n = 0.68 A / d^2
+     * points in an area A (Bolander & Saito; dissertation §3.3.3). Fixed points
+     * closer than that to each other are kept. @p d must have been sampled over
+     * (at least) @p domain; its bounds only set the background grid, so a
+     * sampling that misses an extreme of d costs time, never the distance rule.
+     * Bridson's front grows from the points; when it dies out, every background
+     * grid cell that no point's exclusion disk covers gets 30 random trials, and
+     * the front restarts from each point found: O(n) in all.
+     */
+    std::vector<dealii::Point<2>>
+    poisson_disk_points(const Geometry::Region<2>           &domain,
+                        const Spacing                       &d,
+                        const std::vector<dealii::Point<2>> &fixed,
+                        const std::uint64_t                  seed,
+                        const std::string                   &where);
+
+    /// As above for a constant d_m > 0 (throws InputError(@p where) otherwise).
     std::vector<dealii::Point<2>>
     poisson_disk_points(const Geometry::Region<2>           &domain,
                         const double                         d_m,
@@ -38,13 +101,44 @@ namespace hysteron
                         const std::string                   &where);
 
     /**
-     * Points at spacing of at most @p spacing along the boundary of @p domain
-     * (every straight piece of the polygonized boundary gets its end points and
-     * equally spaced points between), so that the cells of the boundary have
-     * their nuclei on it (supports and loads act there).
+     * Points along the boundary of @p domain, spaced by at most the local d
+     * (@p spacing): the corners of the polygonized boundary (a turn of more than
+     * 20 degrees) and, between two corners, points at equal steps of the
+     * normalised arc length int ds / d(s) (equal arc lengths for a constant d),
+     * so that the cells of the boundary have their nuclei on it (supports and
+     * loads act there).
      */
     std::vector<dealii::Point<2>>
-    boundary_points(const Geometry::Region<2> &domain, const double spacing, const double boundary_h);
+    boundary_points(const Geometry::Region<2> &domain, const Spacing &spacing, const double boundary_h);
+
+    /**
+     * Console lines of a large network's set-up, one per stage: "rbsn: <what> in
+     * <t> s" with the time since the last line. Silent unless @p enabled.
+     */
+    class StageReport
+    {
+    public:
+      StageReport(const dealii::ConditionalOStream &console, const bool enabled);
+
+      /// Print "rbsn: @p what in <t> s" (if enabled) and restart the clock.
+      void
+      operator()(const std::string &what);
+
+      bool
+      enabled() const
+      {
+        return on;
+      }
+
+      /// @p n with thousands separators: 101,234.
+      static std::string
+      count(const std::size_t n);
+
+    private:
+      const dealii::ConditionalOStream &console;
+      const bool                        on;
+      dealii::Timer                     clock;
+    };
 
     /// A Voronoi cell clipped to the domain: a rigid body.
     struct Cell
