@@ -694,9 +694,9 @@ namespace hysteron
         }
       catch (const std::runtime_error &)
         {
-          throw RuntimeError("rbsn: the stiffness matrix is singular: a part of the network is "
-                             "not supported (fewer supports than rigid-body motions, or broken "
-                             "facets have cut it loose)");
+          throw RuntimeError("rbsn: the tangent stiffness matrix is singular: the network is a "
+                             "mechanism (springs without stiffness, e.g. perfectly plastic ones "
+                             "at their limit, or a part that only such springs hold)");
         }
     }
 

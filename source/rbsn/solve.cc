@@ -238,15 +238,31 @@ namespace hysteron
     bool
     Model::solve_step(const double t, const double dt)
     {
-      if (const bool converged = newton_step(t, dt); converged || reuse_tolerance == 0)
+      // A singular tangent (a plastic mechanism, a = 0) fails the attempt like a Newton
+      // failure: a shorter increment may pass it; the run's message gives the reason.
+      const auto attempt = [&]() {
+        try
+          {
+            return newton_step(t, dt);
+          }
+        catch (const RuntimeError &error)
+          {
+            spring_failure.clear();
+            solver_failure = error.what();
+            return false;
+          }
+      };
+      solver_failure.clear();
+      if (const bool converged = attempt(); converged || reuse_tolerance == 0)
         return converged;
       // Modified Newton failed (stale factors can overshoot where springs unload): the
       // step again with a fresh factorization in every iteration.
       const double tolerance = reuse_tolerance;
       reuse_tolerance        = 0;
       factorized             = false;
-      const bool converged   = newton_step(t, dt);
-      reuse_tolerance        = tolerance;
+      solver_failure.clear();
+      const bool converged = attempt();
+      reuse_tolerance      = tolerance;
       ++n_exact_retries;
       return converged;
     }
@@ -646,7 +662,9 @@ namespace hysteron
               if (!broken_since_t.empty())
                 m << "; " << broken_since_t.size() << " facets broke in its last attempt, "
                   << "the network may have fallen apart";
-              if (!spring_failure.empty())
+              if (!solver_failure.empty())
+                m << "; the last attempt failed: " << solver_failure;
+              else if (!spring_failure.empty())
                 m << "; the last failure was in a spring: " << spring_failure;
               else
                 m << "; the last residual was " << rhs.l2_norm() / force_level()

@@ -358,6 +358,7 @@ namespace hysteron
       unsigned long n_newton = 0, n_broken = 0;
       unsigned int  n_cuts = 0;
       std::string   spring_failure;
+      std::string   solver_failure; ///< a singular tangent in the last attempt
       std::vector<int>              probe_cell, probe_facet;
 
       // Fragments (supports.cc): the part of every cell over the intact facets, and the
