@@ -11,6 +11,9 @@ Two scenes at growing cell counts, each run --repeats times (median), pinned to 
     increments, coupled Bouc-Wen springs, backward Euler, Newton), uniform nuclei on both ends.
     Error: the load at 50 mm against P_u = 30 kN. Target: 10,000 cells in under 60 s.
 
+The largest network of each scene also runs on 2 MPI ranks (both cores, not pinned), with each
+distributed solver (Amesos KLU and MUMPS); the 1-rank runs use UMFPACK.
+
 Time: the whole process (MPI start-up, set-up, steps, output), measured around the call, and
 hysteron's own timer sections (set-up, steps, output) of the median run. Memory: the peak
 resident set (/usr/bin/time); per cell, the slope between the two largest runs of a scene (the
@@ -37,7 +40,7 @@ from rbsn_run_time import end_points, rows_of, set_entry, P_U  # noqa: E402
 EPS, LENGTH, REACTION = 5e-4, 2.0, 1e9 * 5e-4 * 0.02 * 0.5
 
 
-def run(hysteron, directory, text):
+def run(hysteron, directory, text, ranks=1):
     """One run: wall time, peak RSS [MB], the summary's counts and the timer sections."""
     os.makedirs(directory, exist_ok=True)
     shutil.rmtree(os.path.join(directory, "output"), ignore_errors=True)
@@ -45,7 +48,9 @@ def run(hysteron, directory, text):
         f.write(text)
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     command = ["/usr/bin/time", "-f", "RSS %M", hysteron, "scene.prm"]
-    if shutil.which("taskset"):
+    if ranks > 1:
+        command = ["/usr/bin/time", "-f", "RSS %M", "mpirun", "-np", str(ranks), hysteron, "scene.prm"]
+    elif shutil.which("taskset"):
         command = ["taskset", "-c", "1"] + command
     start = time.perf_counter()
     p = subprocess.run(command, cwd=directory, env=env, capture_output=True, text=True)
@@ -63,37 +68,41 @@ def run(hysteron, directory, text):
                 newton=int(m.group(4)), factorizations=int(m.group(5)), **sections)
 
 
-def median_run(hysteron, directory, text, repeats):
-    runs = sorted((run(hysteron, directory, text) for _ in range(repeats)), key=lambda r: r["wall"])
+def median_run(hysteron, directory, text, repeats, ranks=1):
+    runs = sorted((run(hysteron, directory, text, ranks) for _ in range(repeats)), key=lambda r: r["wall"])
     return runs[len(runs) // 2]
 
 
-def plate(hysteron, work, d_m, repeats):
+def plate(hysteron, work, d_m, repeats, ranks=1, solver="Amesos_Klu"):
     with open(os.path.join(ROOT, "benchmarks", "rbsn", "plate_uniaxial.prm")) as f:
         text = set_entry(f.read(), "Minimum distance", d_m)
-    d = os.path.join(work, f"plate_{d_m:g}")
-    r = median_run(hysteron, d, text, repeats)
+    text = text.replace("  set Analysis = static", f"  set Analysis = static\n  set Distributed direct solver = {solver}")
+    d = os.path.join(work, f"plate_{d_m:g}_{ranks}_{solver}")
+    r = median_run(hysteron, d, text, repeats, ranks)
     error = 0.0
     for i in range(4):
         last = rows_of(os.path.join(d, "output", f"probe_{i}.csv"))[-1]
         x = float(last["x_x"]) - float(last["u_x"])
         error = max(error, abs(float(last["u_x"]) - EPS * x) / (EPS * LENGTH))
     reaction = float(rows_of(os.path.join(d, "output", "reactions.csv"))[-1]["right_x"])
-    return dict(scene="elastic plate, uniform strain", d_m=d_m, **r,
+    return dict(scene="elastic plate, uniform strain", d_m=d_m, ranks=ranks,
+                solver="UMFPACK" if ranks == 1 else solver, **r,
                 quantity="max |u_x - eps x| / (eps L); reaction error", value=error,
                 error=max(error, abs(reaction / REACTION - 1)))
 
 
-def cantilever(hysteron, work, d_m, repeats):
+def cantilever(hysteron, work, d_m, repeats, ranks=1, solver="Amesos_Klu"):
     with open(os.path.join(ROOT, "prm", "rbsn_cantilever_plastic.prm")) as f:
         text = f.read()
     text = set_entry(text, "Minimum distance", d_m)
+    text = text.replace("  set Spring law = coupled", f"  set Spring law = coupled\n  set Distributed direct solver = {solver}")
     text = set_entry(text, "Additional points", end_points(d_m, 0, 0.1))
     text = set_entry(text, "Write VTU", "false")
-    d = os.path.join(work, f"cantilever_{d_m:g}")
-    r = median_run(hysteron, d, text, repeats)
+    d = os.path.join(work, f"cantilever_{d_m:g}_{ranks}_{solver}")
+    r = median_run(hysteron, d, text, repeats, ranks)
     load = abs(float(rows_of(os.path.join(d, "output", "reactions.csv"))[-1]["tip_y"]))
-    return dict(scene="plastic cantilever (§5.1), 100 increments", d_m=d_m, **r,
+    return dict(scene="plastic cantilever (§5.1), 100 increments", d_m=d_m, ranks=ranks,
+                solver="UMFPACK" if ranks == 1 else solver, **r,
                 quantity="load at 50 mm [N]", value=load, error=abs(load / P_U - 1))
 
 
@@ -116,15 +125,23 @@ def main():
         for d_m in cantilever_dm:
             rows.append(cantilever(hysteron, work, d_m, repeats))
             print(rows[-1], flush=True)
+        # The largest of each on 2 ranks (both cores; no pinning), with both Amesos solvers.
+        for solver in ("Amesos_Klu", "Amesos_Mumps"):
+            rows.append(plate(hysteron, work, plate_dm[-1], repeats, 2, solver))
+            print(rows[-1], flush=True)
+            rows.append(cantilever(hysteron, work, cantilever_dm[-1], repeats, 2, solver))
+            print(rows[-1], flush=True)
     # Memory per cell: the slope of the peak RSS between the two largest runs of each scene.
+    for r in rows:
+        r["kb_per_cell"] = ""
     for scene in dict.fromkeys(r["scene"] for r in rows):
-        runs = [r for r in rows if r["scene"] == scene]
+        runs = [r for r in rows if r["scene"] == scene and r["ranks"] == 1]
         for r in runs:
             r["kb_per_cell"] = ""
         if len(runs) >= 2:
             a, b = runs[-2], runs[-1]
             b["kb_per_cell"] = f"{1024 * (b['rss'] - a['rss']) / (b['cells'] - a['cells']):.2f}"
-    columns = ["scene", "d_m", "cells", "facets", "newton", "factorizations", "wall", "setup_s", "steps_s",
+    columns = ["scene", "d_m", "ranks", "solver", "cells", "facets", "newton", "factorizations", "wall", "setup_s", "steps_s",
                "output_s", "rss", "kb_per_cell", "value", "error"]
     os.makedirs(os.path.dirname(args.output), exist_ok=True)
     with open(args.output + ".csv", "w", newline="") as f:
@@ -132,11 +149,11 @@ def main():
         w.writeheader()
         for r in rows:
             w.writerow({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in r.items()})
-    header = ("| scene | d_m [m] | cells | facets | Newton iterations | factorizations | total [s] | set-up [s] "
+    header = ("| scene | d_m [m] | ranks | solver | cells | facets | Newton iterations | factorizations | total [s] | set-up [s] "
               "| steps [s] | output [s] | peak RSS [MB] | memory per cell [kB] | error |")
     lines = [header, "|" + "---|" * (header.count("|") - 1)]
     for r in rows:
-        lines.append(f"| {r['scene']} | {r['d_m']:g} | {r['cells']:,} | {r['facets']:,} | {r['newton']} | "
+        lines.append(f"| {r['scene']} | {r['d_m']:g} | {r['ranks']} | {r['solver']} | {r['cells']:,} | {r['facets']:,} | {r['newton']} | "
                      f"{r['factorizations']} | {r['wall']:.2f} | {r['setup_s']:.2f} | {r['steps_s']:.2f} | "
                      f"{r['output_s']:.2f} | {r['rss']:.0f} | {r['kb_per_cell'] or '–'} | {r['error']:.2g} |")
     with open(args.output + ".md", "w") as f:

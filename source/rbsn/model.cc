@@ -99,6 +99,15 @@ namespace hysteron
                           "unchanged matrix (elastic steps, Analysis = static). 0.01-0.1: modified "
                           "Newton, more iterations with far fewer factorizations; the converged "
                           "result is the same (same residual tolerance).");
+        prm.declare_entry("Distributed direct solver",
+                          "Amesos_Klu",
+                          Patterns::Selection("Amesos_Klu|Amesos_Mumps"),
+                          "Under mpirun (more than one rank) the cells are split over the ranks "
+                          "(METIS) and the distributed tangent goes to this Trilinos Amesos "
+                          "solver: Amesos_Klu (the default) gathers it and factorizes on one rank, "
+                          "so that a run on N ranks is reproducible bit for bit; Amesos_Mumps "
+                          "factorizes in parallel (faster on large networks), but its results vary "
+                          "at round-off from run to run. Both are refined iteratively.");
         prm.declare_entry("Write spring table",
                           "false",
                           Patterns::Bool(),
@@ -182,6 +191,7 @@ namespace hysteron
         n_increments = s.get_integer("Number of increments");
         spring_table = s.get_bool("Write spring table");
         reuse_tolerance = s.get_non_negative("Tangent reuse tolerance");
+        distributed_solver = s.get("Distributed direct solver");
       }
       newton.parse_parameters(Section(prm, {"RBSN", "Newton"}));
       dynamics.parse_parameters(Section(prm, {"RBSN", "Dynamics"}));
@@ -409,21 +419,25 @@ namespace hysteron
     void
     Model::setup_system()
     {
-      const unsigned int            n = 3 * network.cells.size();
-      dealii::DynamicSparsityPattern dsp(n, n);
-      for (unsigned int c = 0; c < network.cells.size(); ++c)
-        for (unsigned int i = 0; i < 3; ++i)
-          for (unsigned int j = 0; j < 3; ++j)
-            dsp.add(3 * c + i, 3 * c + j);
-      for (const auto &f : network.facets)
-        for (const unsigned int p : {f.a, f.b})
-          for (const unsigned int q : {f.a, f.b})
+      const unsigned int n = 3 * network.cells.size();
+      partition();
+      if (!distributed())
+        {
+          dealii::DynamicSparsityPattern dsp(n, n);
+          for (unsigned int c = 0; c < network.cells.size(); ++c)
             for (unsigned int i = 0; i < 3; ++i)
               for (unsigned int j = 0; j < 3; ++j)
-                dsp.add(3 * p + i, 3 * q + j);
-      pattern.copy_from(dsp);
-      matrix.reinit(pattern);
-      factored_matrix.reinit(pattern);
+                dsp.add(3 * c + i, 3 * c + j);
+          for (const auto &f : network.facets)
+            for (const unsigned int p : {f.a, f.b})
+              for (const unsigned int q : {f.a, f.b})
+                for (unsigned int i = 0; i < 3; ++i)
+                  for (unsigned int j = 0; j < 3; ++j)
+                    dsp.add(3 * p + i, 3 * q + j);
+          pattern.copy_from(dsp);
+          matrix.reinit(pattern);
+          factored_matrix.reinit(pattern);
+        }
       factorized = false;
       direct->clear();
       for (Vector *w : {&u, &u_trial, &v, &a, &rhs, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
@@ -661,6 +675,8 @@ namespace hysteron
     void
     Model::solve_linear(Vector &x)
     {
+      if (distributed())
+        return solve_distributed(x);
       // Refactorize only on change: an unchanged tangent (elastic steps, static analyses)
       // keeps its factors; with a reuse tolerance, a tangent within it of the factorized
       // one too (modified Newton), unless the last correction with stale factors reduced
@@ -710,6 +726,8 @@ namespace hysteron
         << (analysis == Analysis::variable_order ? n_steps : steps) << " steps, " << n_newton
         << " Newton iterations";
       s << ", " << n_factorizations << " factorizations";
+      if (distributed())
+        s << " (" << distributed_solver << " on " << n_ranks << " MPI ranks)";
       if (n_exact_retries > 0)
         s << " (" << n_exact_retries << " steps again with exact Newton)";
       if (fracture.enabled)

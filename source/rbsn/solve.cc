@@ -32,7 +32,9 @@ namespace hysteron
     {
       const bool   dynamic = analysis == Analysis::implicit_dynamics && dt > 0;
       const double alpha = dynamics.hht_alpha, beta = dynamics.beta(), gamma = dynamics.gamma();
-      if (with_matrix)
+      if (with_matrix && distributed())
+        parallel_matrix = 0;
+      else if (with_matrix)
         matrix = 0;
       rhs     = 0;
       f_int   = 0;
@@ -48,7 +50,7 @@ namespace hysteron
       for (unsigned int e = 0; e < springs.size(); ++e)
         {
           Springs &sp = springs[e];
-          if (sp.broken)
+          if (sp.broken || (distributed() && !owned_facet[e]))
             continue;
           const Facet &f = network.facets[e];
           for (unsigned int k = 0; k < 3; ++k)
@@ -159,10 +161,7 @@ namespace hysteron
           for (unsigned int k = 0; k < 6; ++k)
             f_int(dofs[k]) += fe[k];
           r *= -1.0;
-          if (with_matrix)
-            constraints.distribute_local_to_global(K, r, dofs, matrix, rhs, true);
-          else
-            constraints.distribute_local_to_global(r, dofs, rhs);
+          add_local(K, r, dofs, with_matrix);
         }
 
       if (with_matrix && !dynamic && !lone_cells.empty())
@@ -175,11 +174,12 @@ namespace hysteron
           for (unsigned int k = 0; k < 3; ++k)
             D(k, k) = springs.empty() ? 1.0 : springs[0].k[0];
           for (const unsigned int c : lone_cells)
-            {
-              for (unsigned int k = 0; k < 3; ++k)
-                cd[k] = 3 * c + k;
-              constraints.distribute_local_to_global(D, zero, cd, matrix, rhs, true);
-            }
+            if (!distributed() || cell_owner[c] == rank)
+              {
+                for (unsigned int k = 0; k < 3; ++k)
+                  cd[k] = 3 * c + k;
+                add_local(D, zero, cd, true);
+              }
         }
 
       if (dynamic)
@@ -191,6 +191,8 @@ namespace hysteron
           const double c_M = 1 / (beta * dt * dt) + (1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_mass;
           for (unsigned int c = 0; c < network.cells.size(); ++c)
             {
+              if (distributed() && cell_owner[c] != rank)
+                continue;
               cell_mass_matrix(c, M);
               for (unsigned int k = 0; k < 3; ++k)
                 {
@@ -208,14 +210,29 @@ namespace hysteron
               M.vmult(Mx, v0);
               rc.add(-alpha * dynamics.rayleigh_mass, Mx);
               rc *= -1.0;
-              if (with_matrix)
-                {
-                  dealii::FullMatrix<double> A(3, 3);
-                  A.add(c_M, M);
-                  constraints.distribute_local_to_global(A, rc, cd, matrix, rhs, true);
-                }
-              else
-                constraints.distribute_local_to_global(rc, cd, rhs);
+              dealii::FullMatrix<double> A(3, 3);
+              A.add(c_M, M);
+              add_local(A, rc, cd, with_matrix);
+            }
+        }
+
+      if (distributed())
+        {
+          // Each rank added its facets and cells: the sums, and whether a spring failed.
+          if (with_matrix)
+            parallel_matrix.compress(dealii::VectorOperation::add);
+          for (Vector *x : {&rhs, &f_int, &inertia})
+            sum_over_ranks(*x);
+          const MPI_Comm comm = scene.mpi_communicator();
+          if (dealii::Utilities::MPI::logical_or(failed, comm))
+            {
+              failed = true;
+              for (const auto &m : dealii::Utilities::MPI::all_gather(comm, message))
+                if (!m.empty())
+                  {
+                    message = m;
+                    break;
+                  }
             }
         }
 
@@ -322,15 +339,21 @@ namespace hysteron
     Model::commit(const double dt, const bool broke)
     {
       double work = 0; // of the intact springs in the step (trapezoidal rule)
-      for (auto &sp : springs)
+      for (unsigned int e = 0; e < springs.size(); ++e)
         {
-          if (sp.broken)
+          Springs &sp = springs[e];
+          if (sp.broken || (distributed() && !owned_facet[e]))
             continue;
           for (unsigned int i = 0; i < 3; ++i)
             work += 0.5 * (sp.force[i] + sp.trial_force[i]) * (sp.trial_delta[i] - sp.delta[i]);
           sp.delta = sp.trial_delta;
           sp.force = sp.trial_force;
           sp.state = sp.trial_state;
+        }
+      if (distributed())
+        {
+          work = dealii::Utilities::MPI::sum(work, scene.mpi_communicator());
+          synchronize_springs();
         }
       Vector increment = u_trial;
       increment -= u;
@@ -383,7 +406,7 @@ namespace hysteron
       for (unsigned int e = 0; e < springs.size(); ++e)
         {
           const Springs &sp = springs[e];
-          if (sp.broken)
+          if (sp.broken || (distributed() && !owned_facet[e]))
             continue;
           const double area = sp.thickness * network.facets[e].length;
           const double s_n = sp.trial_force[0] / area, s_t = sp.trial_force[1] / area;
@@ -394,6 +417,19 @@ namespace hysteron
               R_max = R;
               worst = e;
             }
+        }
+      if (distributed())
+        {
+          // The largest R over the ranks (MAXLOC: the lowest facet index among equal R,
+          // as the serial loop's first maximum).
+          struct
+          {
+            double R;
+            int    facet;
+          } mine{R_max, worst}, all{};
+          const int ierr = MPI_Allreduce(&mine, &all, 1, MPI_DOUBLE_INT, MPI_MAXLOC, scene.mpi_communicator());
+          AssertThrowMPI(ierr);
+          worst = all.R > 1 ? all.facet : -1;
         }
       return worst;
     }
@@ -420,23 +456,34 @@ namespace hysteron
         if (dof_set[i] >= 0)
           v(i) = prescribed_velocity(dirichlet[dof_set[i]], i, 0);
       make_constraints(0, 0, false);
-      matrix = 0;
-      rhs    = 0;
+      if (distributed())
+        parallel_matrix = 0;
+      else
+        matrix = 0;
+      rhs = 0;
       dealii::FullMatrix<double>                   M(3, 3);
-      dealii::Vector<double>                       zero(3);
+      dealii::Vector<double>                       zero(3), vc(3), Mvc(3);
       std::vector<dealii::types::global_dof_index> cd(3);
+      Vector                                       Mv(v.size());
       for (unsigned int c = 0; c < network.cells.size(); ++c)
         {
           cell_mass_matrix(c, M);
           for (unsigned int k = 0; k < 3; ++k)
-            cd[k] = 3 * c + k;
-          constraints.distribute_local_to_global(M, zero, cd, matrix, rhs);
+            {
+              cd[k] = 3 * c + k;
+              vc[k] = v(cd[k]);
+            }
+          M.vmult(Mvc, vc); // M v, cell by cell (M is block diagonal)
+          for (unsigned int k = 0; k < 3; ++k)
+            Mv(cd[k]) = Mvc[k];
+          if (!distributed() || cell_owner[c] == rank)
+            add_local(M, zero, cd, true);
         }
+      if (distributed())
+        parallel_matrix.compress(dealii::VectorOperation::add);
       // C v0 = a0 M v0 + a1 K0 v0.
       Vector force = f_ext;
       force -= f_int;
-      Vector Mv(v.size());
-      matrix.vmult(Mv, v);
       force.add(-dynamics.rayleigh_mass, Mv);
       if (dynamics.rayleigh_stiffness > 0)
         for (unsigned int e = 0; e < springs.size(); ++e)
@@ -609,6 +656,13 @@ namespace hysteron
             fail_at_t("rbsn: more than " + std::to_string(fracture.max_cycles) +
                       " facets break in the step to t = " + std::to_string(t + dt) +
                       " s: the network falls apart.");
+          if (distributed())
+            {
+              // The owner's trial forces of the facet, for its fracture.csv row.
+              const int ierr = MPI_Bcast(springs[e].trial_force.data(), 3, MPI_DOUBLE,
+                                         cell_owner[network.facets[e].a], scene.mpi_communicator());
+              AssertThrowMPI(ierr);
+            }
           springs[e].broken = true;
           ++n_broken;
           broken_since_t.push_back(e);

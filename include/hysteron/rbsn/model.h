@@ -5,6 +5,10 @@
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/base/index_set.h>
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/trilinos_solver.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 
 #include <hysteron/base/implicit_dynamics.h>
@@ -220,6 +224,35 @@ namespace hysteron
       commit(const double dt, const bool broke);
       void
       solve_linear(Vector &x);
+
+      // MPI (parallel.cc): the cells are partitioned over the ranks (METIS on the cell
+      // graph); each rank evaluates the springs of its facets and assembles them into a
+      // distributed Trilinos matrix, solved by Amesos (KLU or MUMPS). The network, the DoF vectors and
+      // (after every step) the springs' state are replicated on every rank.
+      /// More than one MPI rank.
+      bool
+      distributed() const
+      {
+        return n_ranks > 1;
+      }
+      /// The owner of every cell and facet, the owned DoFs and the matrix's sparsity.
+      void
+      partition();
+      /// Sum a replicated vector's rank contributions (the same bits on every rank).
+      void
+      sum_over_ranks(Vector &x) const;
+      /// Every facet's converged spring state from its owner to all ranks.
+      void
+      synchronize_springs();
+      /// solve_linear() on the distributed matrix.
+      void
+      solve_distributed(Vector &x);
+      /// Add a local matrix and vector through the constraints to the system of this rank.
+      void
+      add_local(const dealii::FullMatrix<double>                     &K,
+                const dealii::Vector<double>                         &r,
+                const std::vector<dealii::types::global_dof_index> &dofs,
+                bool                                                 with_matrix);
       /// The facet whose fracture ratio R is largest if above 1, else -1.
       int
       facet_to_break() const;
@@ -315,6 +348,7 @@ namespace hysteron
       VariableOrderParameters       variable_order;
       bool                          spring_table = false;
       double                        reuse_tolerance = 0; ///< `Tangent reuse tolerance`
+      std::string                   distributed_solver;  ///< `Distributed direct solver`
 
       // The network: cells (rigid bodies), facets (springs), bodies.
       Tessellation                          network;
@@ -331,6 +365,16 @@ namespace hysteron
       dealii::SparsityPattern           pattern;
       dealii::SparseMatrix<double>      matrix;
       std::unique_ptr<SparseLU>         direct; ///< UMFPACK, the symbolic analysis kept
+
+      // MPI: ranks, the owner of every cell, the facets this rank evaluates, its DoFs.
+      unsigned int                               n_ranks = 1, rank = 0;
+      std::vector<unsigned int>                  cell_owner;
+      std::vector<bool>                          owned_facet;
+      std::vector<unsigned int>                  owned_facets;
+      dealii::IndexSet                           owned_dofs;
+      dealii::TrilinosWrappers::SparseMatrix     parallel_matrix, factored_parallel;
+      dealii::SolverControl                                   parallel_control{1, 0};
+      std::unique_ptr<dealii::TrilinosWrappers::SolverDirect> parallel_direct; ///< Amesos
       /// The matrix of the factors in `direct` (solve_linear() refactorizes on change).
       dealii::SparseMatrix<double>      factored_matrix;
       bool                              factorized = false, stale_factors = false;

@@ -1,0 +1,265 @@
+// The RBSN under MPI. The network (cells, facets, their geometry) and the DoF
+// vectors are replicated: every rank builds the same network from the same seed.
+// The work is shared: the cells are partitioned over the ranks by METIS on the
+// cell graph (a facet belongs to the owner of its first cell), each rank
+// evaluates the spring laws of its facets and assembles them into a distributed
+// Trilinos matrix, which Amesos factorizes (KLU on one rank, or MUMPS in parallel). After every converged step
+// the facets' states go from their owners to every rank, so that outputs,
+// fracture, fragments and checkpoints see the whole network on every rank.
+#include <deal.II/base/mpi.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/sparsity_tools.h>
+#include <deal.II/lac/trilinos_solver.h>
+#include <deal.II/lac/trilinos_vector.h>
+
+#include <hysteron/rbsn/model.h>
+
+#include <Epetra_CrsMatrix.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace hysteron
+{
+  namespace RBSN
+  {
+    void
+    Model::partition()
+    {
+      const MPI_Comm     comm    = scene.mpi_communicator();
+      const unsigned int n_cells = network.cells.size();
+      // Variable order integrates one serial vector (SUNDIALS IDA): every rank runs the
+      // whole network, as does a network with fewer cells than ranks.
+      const bool replicated = analysis == Analysis::variable_order ||
+                              n_cells < dealii::Utilities::MPI::n_mpi_processes(comm);
+      n_ranks = replicated ? 1 : dealii::Utilities::MPI::n_mpi_processes(comm);
+      rank    = replicated ? 0 : dealii::Utilities::MPI::this_mpi_process(comm);
+      cell_owner.assign(n_cells, 0);
+      if (n_ranks > 1)
+        {
+          // METIS on the graph of the cells joined by facets: balanced parts with
+          // few facets across the cut. The same input gives the same parts on every rank.
+          dealii::DynamicSparsityPattern graph(n_cells, n_cells);
+          for (const auto &f : network.facets)
+            {
+              graph.add(f.a, f.b);
+              graph.add(f.b, f.a);
+            }
+          dealii::SparsityPattern pattern;
+          pattern.copy_from(graph);
+          dealii::SparsityTools::partition(pattern, n_ranks, cell_owner, dealii::SparsityTools::Partitioner::metis);
+        }
+      owned_facet.assign(network.facets.size(), false);
+      owned_facets.clear();
+      for (unsigned int e = 0; e < network.facets.size(); ++e)
+        if (cell_owner[network.facets[e].a] == rank)
+          {
+            owned_facet[e] = true;
+            owned_facets.push_back(e);
+          }
+      owned_dofs.set_size(3 * n_cells);
+      for (unsigned int c = 0; c < n_cells; ++c)
+        if (cell_owner[c] == rank)
+          owned_dofs.add_range(3 * c, 3 * c + 3);
+      owned_dofs.compress();
+      if (!distributed())
+        return;
+
+      // The matrix: the cell blocks of the owned cells and the couplings of the owned
+      // facets (rows of other ranks' cells go to their owners).
+      dealii::IndexSet relevant = owned_dofs;
+      dealii::DynamicSparsityPattern dsp(3 * n_cells, 3 * n_cells);
+      const auto block = [&](const unsigned int p, const unsigned int q) {
+        for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int j = 0; j < 3; ++j)
+            dsp.add(3 * p + i, 3 * q + j);
+      };
+      for (unsigned int c = 0; c < n_cells; ++c)
+        if (cell_owner[c] == rank)
+          block(c, c);
+      for (const unsigned int e : owned_facets)
+        {
+          const Facet &f = network.facets[e];
+          for (const unsigned int p : {f.a, f.b})
+            {
+              relevant.add_range(3 * p, 3 * p + 3);
+              for (const unsigned int q : {f.a, f.b})
+                block(p, q);
+            }
+        }
+      relevant.compress();
+      dealii::SparsityTools::distribute_sparsity_pattern(dsp, owned_dofs, comm, relevant);
+      parallel_matrix.reinit(owned_dofs, owned_dofs, dsp, comm);
+      scene.console() << "rbsn: " << n_ranks << " MPI ranks, " << owned_facets.size() << " of "
+                      << network.facets.size() << " facets on rank " << rank << std::endl;
+    }
+
+
+
+    void
+    Model::sum_over_ranks(Vector &x) const
+    {
+      if (!distributed())
+        return;
+      const MPI_Comm comm = scene.mpi_communicator();
+      // Then the root's sum to all: the same bits everywhere, whatever the reduction order.
+      int ierr = MPI_Allreduce(MPI_IN_PLACE, x.data(), x.size(), MPI_DOUBLE, MPI_SUM, comm);
+      AssertThrowMPI(ierr);
+      ierr = MPI_Bcast(x.data(), x.size(), MPI_DOUBLE, 0, comm);
+      AssertThrowMPI(ierr);
+    }
+
+
+
+    void
+    Model::synchronize_springs()
+    {
+      if (!distributed())
+        return;
+      const MPI_Comm comm = scene.mpi_communicator();
+      // Per facet: delta, force, trial delta, trial force (3 each), the tangent (9) and
+      // the spring law's converged and trial states.
+      const auto pack = [](const Springs &sp, std::vector<double> &buffer) {
+        for (const auto *a : {&sp.delta, &sp.force, &sp.trial_delta, &sp.trial_force})
+          buffer.insert(buffer.end(), a->begin(), a->end());
+        for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int j = 0; j < 3; ++j)
+            buffer.push_back(sp.tangent[i][j]);
+        buffer.insert(buffer.end(), sp.state.begin(), sp.state.end());
+        buffer.insert(buffer.end(), sp.trial_state.begin(), sp.trial_state.end());
+      };
+      std::vector<double> mine;
+      for (const unsigned int e : owned_facets)
+        pack(springs[e], mine);
+      std::vector<int> counts(n_ranks), offsets(n_ranks, 0);
+      const int        n_mine = mine.size();
+      int ierr = MPI_Allgather(&n_mine, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+      AssertThrowMPI(ierr);
+      for (unsigned int r = 1; r < n_ranks; ++r)
+        offsets[r] = offsets[r - 1] + counts[r - 1];
+      std::vector<double> all(offsets.back() + counts.back());
+      ierr = MPI_Allgatherv(mine.data(), n_mine, MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
+                            MPI_DOUBLE, comm);
+      AssertThrowMPI(ierr);
+      // Each rank's facets in increasing order, as that rank packed them.
+      std::vector<std::size_t> position(n_ranks);
+      for (unsigned int r = 0; r < n_ranks; ++r)
+        position[r] = offsets[r];
+      for (unsigned int e = 0; e < springs.size(); ++e)
+        {
+          const unsigned int owner = cell_owner[network.facets[e].a];
+          const double      *p     = all.data() + position[owner];
+          Springs           &sp    = springs[e];
+          for (auto *a : {&sp.delta, &sp.force, &sp.trial_delta, &sp.trial_force})
+            for (auto &x : *a)
+              x = *p++;
+          for (unsigned int i = 0; i < 3; ++i)
+            for (unsigned int j = 0; j < 3; ++j)
+              sp.tangent[i][j] = *p++;
+          for (auto &x : sp.state)
+            x = *p++;
+          for (auto &x : sp.trial_state)
+            x = *p++;
+          position[owner] = p - all.data();
+        }
+    }
+
+
+
+    void
+    Model::add_local(const dealii::FullMatrix<double>                     &K,
+                     const dealii::Vector<double>                         &r,
+                     const std::vector<dealii::types::global_dof_index> &dofs,
+                     const bool                                           with_matrix)
+    {
+      if (!with_matrix)
+        constraints.distribute_local_to_global(r, dofs, rhs);
+      else if (distributed())
+        constraints.distribute_local_to_global(K, r, dofs, parallel_matrix, rhs, true);
+      else
+        constraints.distribute_local_to_global(K, r, dofs, matrix, rhs, true);
+    }
+
+
+
+    void
+    Model::solve_distributed(Vector &x)
+    {
+      using namespace dealii;
+      const MPI_Comm comm = scene.mpi_communicator();
+      // Refactorize on change, as solve_linear() (the change summed over the ranks' rows).
+      const double residual = rhs.l2_norm();
+      double       change   = std::numeric_limits<double>::infinity();
+      if (factorized)
+        {
+          // The two matrices share their graph (copy_from): compare the local rows' values.
+          double                  sums[2] = {0, 0};
+          const Epetra_CrsMatrix &A = parallel_matrix.trilinos_matrix(), &F = factored_parallel.trilinos_matrix();
+          for (int row = 0; row < A.NumMyRows(); ++row)
+            {
+              int     n_a = 0, n_f = 0;
+              double *a = nullptr, *f = nullptr;
+              A.ExtractMyRowView(row, n_a, a);
+              F.ExtractMyRowView(row, n_f, f);
+              for (int k = 0; k < std::min(n_a, n_f); ++k)
+                {
+                  sums[0] += (a[k] - f[k]) * (a[k] - f[k]);
+                  sums[1] += f[k] * f[k];
+                }
+            }
+          const int ierr = MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, comm);
+          AssertThrowMPI(ierr);
+          change = std::sqrt(sums[0] / sums[1]);
+        }
+      const bool slow = stale_factors && residual > 0.5 * previous_residual;
+      TrilinosWrappers::MPI::Vector b(owned_dofs, comm), y(owned_dofs, comm), r(owned_dofs, comm),
+        d(owned_dofs, comm);
+      try
+        {
+          if (!(change <= reuse_tolerance) || slow)
+            {
+              // The factors belong to a copy, so that the assembly can go on in parallel_matrix.
+              factored_parallel.copy_from(parallel_matrix);
+              parallel_direct = std::make_unique<TrilinosWrappers::SolverDirect>(
+                parallel_control, TrilinosWrappers::SolverDirect::AdditionalData(false, distributed_solver));
+              parallel_direct->initialize(factored_parallel);
+              factorized = true;
+              ++n_factorizations;
+              change = 0;
+            }
+          stale_factors     = change > 0;
+          previous_residual = residual;
+          for (const auto i : owned_dofs)
+            b(i) = rhs(i);
+          b.compress(VectorOperation::insert);
+          parallel_direct->solve(y, b);
+          // Iterative refinement against the factorized matrix (the rotations' stiffness
+          // k l^2 / 12 is far below the translations' k: the pivots lose digits).
+          const double target = 1e-14 * b.l2_norm();
+          double       last   = std::numeric_limits<double>::infinity();
+          for (unsigned int k = 0; k < 3; ++k)
+            {
+              const double norm = factored_parallel.residual(r, y, b);
+              if (!(norm > target) || !(norm < 0.5 * last))
+                break;
+              last = norm;
+              parallel_direct->solve(d, r);
+              y += d;
+            }
+        }
+      catch (const ExceptionBase &)
+        {
+          throw RuntimeError("rbsn: the tangent stiffness matrix is singular: the network is a "
+                             "mechanism (springs without stiffness, e.g. perfectly plastic ones "
+                             "at their limit, or a part that only such springs hold)");
+        }
+      x = 0;
+      for (const auto i : owned_dofs)
+        x(i) = y(i);
+      sum_over_ranks(x);
+    }
+  } // namespace RBSN
+} // namespace hysteron
