@@ -85,10 +85,12 @@ def plate(hysteron, work, d_m, repeats, ranks=1, solver="Amesos_Klu"):
         x = float(last["x_x"]) - float(last["u_x"])
         error = max(error, abs(float(last["u_x"]) - EPS * x) / (EPS * LENGTH))
     reaction = float(rows_of(os.path.join(d, "output", "reactions.csv"))[-1]["right_x"])
+    # The network's solution is exact (reaction to round-off); a probe reads the rigid motion of
+    # its cell, eps x_nucleus, so |u_x - eps x| at a point is the O(d_m) piecewise-rigid error.
     return dict(scene="elastic plate, uniform strain", d_m=d_m, ranks=ranks,
                 solver="UMFPACK" if ranks == 1 else solver, **r,
-                quantity="max |u_x - eps x| / (eps L); reaction error", value=error,
-                error=max(error, abs(reaction / REACTION - 1)))
+                quantity="reaction error; max |u_x - eps x| / (eps L) at the probes", value=error,
+                error=abs(reaction / REACTION - 1))
 
 
 def cantilever(hysteron, work, d_m, repeats, ranks=1, solver="Amesos_Klu"):
@@ -151,12 +153,13 @@ def main():
         for r in rows:
             w.writerow({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in r.items()})
     header = ("| scene | d_m [m] | ranks | solver | cells | facets | Newton iterations | factorizations | total [s] | set-up [s] "
-              "| steps [s] | output [s] | peak RSS [MB] | memory per cell [kB] | error |")
+              "| steps [s] | output [s] | peak RSS [MB] | memory per cell [kB] | error | second value |")
     lines = [header, "|" + "---|" * (header.count("|") - 1)]
     for r in rows:
         lines.append(f"| {r['scene']} | {r['d_m']:g} | {r['ranks']} | {r['solver']} | {r['cells']:,} | {r['facets']:,} | {r['newton']} | "
                      f"{r['factorizations']} | {r['wall']:.2f} | {r['setup_s']:.2f} | {r['steps_s']:.2f} | "
-                     f"{r['output_s']:.2f} | {r['rss']:.0f} | {r['kb_per_cell'] or '–'} | {r['error']:.2g} |")
+                     f"{r['output_s']:.2f} | {r['rss']:.0f} | {r['kb_per_cell'] or '–'} | {r['error']:.2g} | "
+                     f"{r['value']:.4g} |")
     with open(args.output + ".md", "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
