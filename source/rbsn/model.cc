@@ -108,6 +108,23 @@ namespace hysteron
                           "so that a run on N ranks is reproducible bit for bit; Amesos_Mumps "
                           "factorizes in parallel (faster on large networks), but its results vary "
                           "at round-off from run to run. Both are refined iteratively.");
+        prm.declare_entry("Linear solver",
+                          "direct",
+                          Patterns::Selection("direct|cg|gmres"),
+                          "direct: UMFPACK on one rank, `Distributed direct solver` on several; "
+                          "cg (the uncoupled and elastic springs: a symmetric tangent) or gmres: "
+                          "Krylov iterations with ML algebraic multigrid that knows the three "
+                          "rigid-body modes of every cell (translations and the rotation about the "
+                          "origin), to `Linear solver tolerance` of the residual.");
+        prm.declare_entry("Linear solver tolerance",
+                          "1e-10",
+                          Patterns::Double(),
+                          "cg / gmres: the linear residual relative to the right-hand side, in "
+                          "(0, 1); below Newton's tolerance.");
+        prm.declare_entry("Linear solver iterations",
+                          "1000",
+                          Patterns::Integer(1),
+                          "cg / gmres: iterations before the attempt fails (and the increment is cut).");
         prm.declare_entry("Write spring table",
                           "false",
                           Patterns::Bool(),
@@ -192,6 +209,14 @@ namespace hysteron
         spring_table = s.get_bool("Write spring table");
         reuse_tolerance = s.get_non_negative("Tangent reuse tolerance");
         distributed_solver = s.get("Distributed direct solver");
+        linear_solver      = s.get("Linear solver");
+        solver_tolerance   = s.get_positive("Linear solver tolerance");
+        require(solver_tolerance < 1, s.where("Linear solver tolerance"), "must be below 1");
+        solver_max_iterations = s.get_integer("Linear solver iterations");
+        require(linear_solver != "cg" || spring_law->diagonal_tangent() || analysis == Analysis::linear_static,
+                s.where("Linear solver"),
+                "cg needs a symmetric tangent; the " + spring_law_name +
+                  " spring law couples its springs (unsymmetric): use gmres or direct");
       }
       newton.parse_parameters(Section(prm, {"RBSN", "Newton"}));
       dynamics.parse_parameters(Section(prm, {"RBSN", "Dynamics"}));
@@ -421,7 +446,7 @@ namespace hysteron
     {
       const unsigned int n = 3 * network.cells.size();
       partition();
-      if (!distributed())
+      if (!trilinos_system())
         {
           dealii::DynamicSparsityPattern dsp(n, n);
           for (unsigned int c = 0; c < network.cells.size(); ++c)
@@ -675,7 +700,7 @@ namespace hysteron
     void
     Model::solve_linear(Vector &x)
     {
-      if (distributed())
+      if (trilinos_system())
         return solve_distributed(x);
       // Refactorize only on change: an unchanged tangent (elastic steps, static analyses)
       // keeps its factors; with a reuse tolerance, a tangent within it of the factorized
@@ -726,7 +751,9 @@ namespace hysteron
         << (analysis == Analysis::variable_order ? n_steps : steps) << " steps, " << n_newton
         << " Newton iterations";
       s << ", " << n_factorizations << " factorizations";
-      if (distributed())
+      if (linear_solver != "direct")
+        s << " (" << linear_solver << " + AMG, " << n_linear_iterations << " iterations)";
+      else if (distributed())
         s << " (" << distributed_solver << " on " << n_ranks << " MPI ranks)";
       if (n_exact_retries > 0)
         s << " (" << n_exact_retries << " steps again with exact Newton)";

@@ -8,9 +8,13 @@
 // fracture, fragments and checkpoints see the whole network on every rank.
 #include <deal.II/base/mpi.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/solver_gmres.h>
 #include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/sparsity_tools.h>
+#include <deal.II/lac/trilinos_index_access.h>
+#include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_solver.h>
 #include <deal.II/lac/trilinos_vector.h>
 
@@ -21,6 +25,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 namespace hysteron
 {
@@ -65,7 +70,7 @@ namespace hysteron
         if (cell_owner[c] == rank)
           owned_dofs.add_range(3 * c, 3 * c + 3);
       owned_dofs.compress();
-      if (!distributed())
+      if (!trilinos_system())
         return;
 
       // The matrix: the cell blocks of the owned cells and the couplings of the owned
@@ -93,8 +98,9 @@ namespace hysteron
       relevant.compress();
       dealii::SparsityTools::distribute_sparsity_pattern(dsp, owned_dofs, comm, relevant);
       parallel_matrix.reinit(owned_dofs, owned_dofs, dsp, comm);
-      scene.console() << "rbsn: " << n_ranks << " MPI ranks, " << owned_facets.size() << " of "
-                      << network.facets.size() << " facets on rank " << rank << std::endl;
+      if (distributed())
+        scene.console() << "rbsn: " << n_ranks << " MPI ranks, " << owned_facets.size() << " of "
+                        << network.facets.size() << " facets on rank " << rank << std::endl;
     }
 
 
@@ -177,7 +183,7 @@ namespace hysteron
     {
       if (!with_matrix)
         constraints.distribute_local_to_global(r, dofs, rhs);
-      else if (distributed())
+      else if (trilinos_system())
         constraints.distribute_local_to_global(K, r, dofs, parallel_matrix, rhs, true);
       else
         constraints.distribute_local_to_global(K, r, dofs, matrix, rhs, true);
@@ -217,6 +223,8 @@ namespace hysteron
       const bool slow = stale_factors && residual > 0.5 * previous_residual;
       TrilinosWrappers::MPI::Vector b(owned_dofs, comm), y(owned_dofs, comm), r(owned_dofs, comm),
         d(owned_dofs, comm);
+      if (linear_solver != "direct")
+        return solve_iterative(x, change, slow);
       try
         {
           if (!(change <= reuse_tolerance) || slow)
@@ -256,6 +264,83 @@ namespace hysteron
                              "mechanism (springs without stiffness, e.g. perfectly plastic ones "
                              "at their limit, or a part that only such springs hold)");
         }
+      x = 0;
+      for (const auto i : owned_dofs)
+        x(i) = y(i);
+      sum_over_ranks(x);
+    }
+
+
+
+    void
+    Model::solve_iterative(Vector &x, const double change, const bool slow)
+    {
+      using namespace dealii;
+      const MPI_Comm comm = scene.mpi_communicator();
+      if (!(change <= reuse_tolerance) || slow || !amg)
+        {
+          // ML aggregation with the null space of the network: per cell the translations
+          // (1, 0, 0), (0, 1, 0) and the rotation (-(y - y_0), x - x_0, 1) about the centre.
+          TrilinosWrappers::PreconditionAMG::AdditionalData data(true, false, 1, false, 1e-4, {}, 2, 0, false,
+                                                                 "Chebyshev", "Amesos-KLU");
+          Teuchos::ParameterList              list;
+          std::unique_ptr<Epetra_MultiVector> constant_modes;
+          data.set_parameters(list, constant_modes, parallel_matrix);
+          const Epetra_Map &map     = parallel_matrix.trilinos_matrix().RowMap();
+          const int         n_local = map.NumMyElements();
+          dealii::Point<2>  lo(1e300, 1e300), hi(-1e300, -1e300);
+          for (const auto &cell : network.cells)
+            for (unsigned int d = 0; d < 2; ++d)
+              {
+                lo[d] = std::min(lo[d], cell.nucleus[d]);
+                hi[d] = std::max(hi[d], cell.nucleus[d]);
+              }
+          const dealii::Point<2> centre = 0.5 * (lo + hi);
+          null_space.assign(3 * n_local, 0.0);
+          for (int i = 0; i < n_local; ++i)
+            {
+              const auto               g = TrilinosWrappers::global_index(map, i);
+              const unsigned int       k = g % 3;
+              const dealii::Tensor<1, 2> r = network.cells[g / 3].nucleus - centre;
+              null_space[i]               = k == 0 ? 1.0 : 0.0;
+              null_space[n_local + i]     = k == 1 ? 1.0 : 0.0;
+              null_space[2 * n_local + i] = k == 0 ? -r[1] : k == 1 ? r[0] : 1.0;
+            }
+          list.set("PDE equations", 3);
+          list.set("null space: type", "pre-computed");
+          list.set("null space: dimension", 3);
+          list.set("null space: vectors", null_space.data());
+          amg = std::make_unique<TrilinosWrappers::PreconditionAMG>();
+          amg->initialize(parallel_matrix.trilinos_matrix(), list);
+          factored_parallel.copy_from(parallel_matrix);
+          factorized = true;
+          ++n_factorizations;
+        }
+      stale_factors     = !(change <= 0);
+      previous_residual = rhs.l2_norm();
+      TrilinosWrappers::MPI::Vector b(owned_dofs, comm), y(owned_dofs, comm);
+      for (const auto i : owned_dofs)
+        b(i) = rhs(i);
+      b.compress(VectorOperation::insert);
+      SolverControl control(solver_max_iterations, std::max(1e-300, solver_tolerance * b.l2_norm()));
+      try
+        {
+          if (linear_solver == "cg")
+            SolverCG<TrilinosWrappers::MPI::Vector>(control).solve(parallel_matrix, y, b, *amg);
+          else
+            SolverGMRES<TrilinosWrappers::MPI::Vector>(control,
+                                                       SolverGMRES<TrilinosWrappers::MPI::Vector>::AdditionalData(100, true))
+              .solve(parallel_matrix, y, b, *amg);
+        }
+      catch (const SolverControl::NoConvergence &e)
+        {
+          std::ostringstream m;
+          m << "rbsn: the " << linear_solver << " solver did not converge in " << e.last_step
+            << " iterations (residual " << e.last_residual << ", target " << control.tolerance()
+            << "); raise RBSN/Linear solver iterations or use Linear solver = direct";
+          throw RuntimeError(m.str());
+        }
+      n_linear_iterations += control.last_step();
       x = 0;
       for (const auto i : owned_dofs)
         x(i) = y(i);

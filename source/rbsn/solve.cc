@@ -32,7 +32,7 @@ namespace hysteron
     {
       const bool   dynamic = analysis == Analysis::implicit_dynamics && dt > 0;
       const double alpha = dynamics.hht_alpha, beta = dynamics.beta(), gamma = dynamics.gamma();
-      if (with_matrix && distributed())
+      if (with_matrix && trilinos_system())
         parallel_matrix = 0;
       else if (with_matrix)
         matrix = 0;
@@ -216,11 +216,11 @@ namespace hysteron
             }
         }
 
+      if (with_matrix && trilinos_system())
+        parallel_matrix.compress(dealii::VectorOperation::add);
       if (distributed())
         {
           // Each rank added its facets and cells: the sums, and whether a spring failed.
-          if (with_matrix)
-            parallel_matrix.compress(dealii::VectorOperation::add);
           for (Vector *x : {&rhs, &f_int, &inertia})
             sum_over_ranks(*x);
           const MPI_Comm comm = scene.mpi_communicator();
@@ -456,7 +456,7 @@ namespace hysteron
         if (dof_set[i] >= 0)
           v(i) = prescribed_velocity(dirichlet[dof_set[i]], i, 0);
       make_constraints(0, 0, false);
-      if (distributed())
+      if (trilinos_system())
         parallel_matrix = 0;
       else
         matrix = 0;
@@ -479,7 +479,7 @@ namespace hysteron
           if (!distributed() || cell_owner[c] == rank)
             add_local(M, zero, cd, true);
         }
-      if (distributed())
+      if (trilinos_system())
         parallel_matrix.compress(dealii::VectorOperation::add);
       // C v0 = a0 M v0 + a1 K0 v0.
       Vector force = f_ext;

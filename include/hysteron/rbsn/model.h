@@ -7,6 +7,7 @@
 #include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/base/index_set.h>
 #include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_solver.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/vector.h>
@@ -235,6 +236,12 @@ namespace hysteron
       {
         return n_ranks > 1;
       }
+      /// The system is a Trilinos matrix (several ranks, or an iterative solver).
+      bool
+      trilinos_system() const
+      {
+        return distributed() || linear_solver != "direct";
+      }
       /// The owner of every cell and facet, the owned DoFs and the matrix's sparsity.
       void
       partition();
@@ -247,6 +254,10 @@ namespace hysteron
       /// solve_linear() on the distributed matrix.
       void
       solve_distributed(Vector &x);
+      /// solve_distributed() with cg / gmres and ML: the preconditioner is rebuilt as the
+      /// factors would be (@p change of the matrix, @p slow convergence of Newton).
+      void
+      solve_iterative(Vector &x, double change, bool slow);
       /// Add a local matrix and vector through the constraints to the system of this rank.
       void
       add_local(const dealii::FullMatrix<double>                     &K,
@@ -349,6 +360,10 @@ namespace hysteron
       bool                          spring_table = false;
       double                        reuse_tolerance = 0; ///< `Tangent reuse tolerance`
       std::string                   distributed_solver;  ///< `Distributed direct solver`
+      std::string                   linear_solver;       ///< `Linear solver`: direct, cg, gmres
+      double                        solver_tolerance = 1e-10;
+      unsigned int                  solver_max_iterations = 1000;
+      unsigned long                 n_linear_iterations = 0;
 
       // The network: cells (rigid bodies), facets (springs), bodies.
       Tessellation                          network;
@@ -375,6 +390,9 @@ namespace hysteron
       dealii::TrilinosWrappers::SparseMatrix     parallel_matrix, factored_parallel;
       dealii::SolverControl                                   parallel_control{1, 0};
       std::unique_ptr<dealii::TrilinosWrappers::SolverDirect> parallel_direct; ///< Amesos
+      /// cg / gmres: ML algebraic multigrid with the cells' rigid-body modes.
+      std::unique_ptr<dealii::TrilinosWrappers::PreconditionAMG> amg;
+      std::vector<double>                                        null_space;
       /// The matrix of the factors in `direct` (solve_linear() refactorizes on change).
       dealii::SparseMatrix<double>      factored_matrix;
       bool                              factorized = false, stale_factors = false;
