@@ -3,7 +3,7 @@
 by a cell field, and the broken facets (the line cells of the file with broken = 1) as red lines.
 
 Usage:
-  plot_rbsn_cells.py FILE.vtu OUT.png [--field H1] [--magnify 50] [--title "..."]
+  plot_rbsn_cells.py FILE.vtu|FILE.pvtu OUT.png [--field H1] [--magnify 50] [--title "..."]
                      [--xlim a b] [--ylim a b] [--label "colour bar label"]
 
 The VTU is the file hysteron writes (inline binary arrays, base64 with a UInt64 byte count;
@@ -37,6 +37,25 @@ def decode(attributes, body):
 
 
 def read_vtu(path):
+    if path.endswith(".pvtu"):
+        # An MPI run's record: its pieces, one per rank, joined.
+        import os
+        text = open(path).read()
+        joined = None
+        for source in re.findall(r'<Piece Source="([^"]+)"', text):
+            piece = read_vtu(os.path.join(os.path.dirname(path), source))
+            if joined is None:
+                joined = piece
+                continue
+            points, connectivity, offsets, types, fields = joined
+            shift, end = len(points), (offsets[-1] if offsets else 0)
+            points += piece[0]
+            connectivity += [c + shift for c in piece[1]]
+            offsets += [o + end for o in piece[2]]
+            types += piece[3]
+            for name, values in piece[4].items():
+                fields[name] = (fields.get(name) or []) + values
+        return joined
     text = open(path).read()
 
     def array(name):

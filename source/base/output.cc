@@ -263,33 +263,47 @@ namespace hysteron
     void
     FieldWriter::write(dealii::DataOutInterface<dim, spacedim> &data_out, const double time)
     {
-      // A failing run writes its last good state, which may already be written.
-      if (!times_and_names.empty() && times_and_names.back().first == time)
-        return;
       // zlib's fastest level: the default (best compression) made writing a particle
       // VTU cost about four times the 40 steps between two outputs
       // (doc/benchmarks/pay_for_use.md); the files are a little larger.
       dealii::DataOutBase::VtkFlags flags(time, counter, false); // no date: identical reruns
       flags.compression_level = dealii::DataOutBase::VtkFlags::best_speed;
       data_out.set_flags(flags);
+      write_pieces([&](std::ostream &out) { data_out.write_vtu(out); },
+                   [&](std::ostream &out, const std::vector<std::string> &pieces) {
+                     data_out.write_pvtu_record(out, pieces);
+                   },
+                   time);
+    }
+
+
+
+    void
+    FieldWriter::write_pieces(const std::function<void(std::ostream &)>                                   &piece,
+                              const std::function<void(std::ostream &, const std::vector<std::string> &)> &record_writer,
+                              const double                                                                time)
+    {
+      // A failing run writes its last good state, which may already be written.
+      if (!times_and_names.empty() && times_and_names.back().first == time)
+        return;
       const unsigned int n_ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
       const unsigned int rank    = dealii::Utilities::MPI::this_mpi_process(comm);
-      const std::string  stem = base_name + "-" + dealii::Utilities::int_to_string(counter, 5);
+      const std::string  stem    = base_name + "-" + dealii::Utilities::int_to_string(counter, 5);
 
       std::string record;
       if (n_ranks == 1)
         {
           record = stem + ".vtu";
           AtomicFile file(directory + "/" + record);
-          data_out.write_vtu(file.stream());
+          piece(file.stream());
           file.commit();
         }
       else
         {
-          const std::string piece = stem + "." + dealii::Utilities::int_to_string(rank, 4) + ".vtu";
+          const std::string mine = stem + "." + dealii::Utilities::int_to_string(rank, 4) + ".vtu";
           {
-            AtomicFile file(directory + "/" + piece);
-            data_out.write_vtu(file.stream());
+            AtomicFile file(directory + "/" + mine);
+            piece(file.stream());
             file.commit();
           }
           std::vector<std::string> pieces;
@@ -301,7 +315,7 @@ namespace hysteron
           if (rank == 0)
             {
               AtomicFile file(directory + "/" + record);
-              data_out.write_pvtu_record(file.stream(), pieces);
+              record_writer(file.stream(), pieces);
               file.commit();
             }
         }
@@ -340,6 +354,8 @@ namespace hysteron
       dealii::DataOutBase::write_pvd_record(file.stream(), times_and_names);
       file.commit();
     }
+
+
 
     template void
     FieldWriter::write<1, 2>(dealii::DataOutInterface<1, 2> &, double);

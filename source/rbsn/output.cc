@@ -12,6 +12,16 @@ namespace hysteron
 {
   namespace RBSN
   {
+    namespace
+    {
+      /// The VTU's cell arrays, in write_vtu()'s order: six Int32, then Float64.
+      const std::vector<const char *> vtu_cell_fields{"cell",     "facet", "body", "broken", "fragment",
+                                                      "released", "rotation", "H1", "f_n",    "f_t",
+                                                      "m",        "s_n",   "s_t"};
+    } // namespace
+
+
+
     std::vector<std::string>
     Model::point_columns() const
     {
@@ -219,9 +229,12 @@ namespace hysteron
         if (springs[e].hysteretic && !springs[e].broken)
           for (const unsigned int c : {network.facets[e].a, network.facets[e].b})
             cell_h1[c] = std::max(cell_h1[c], this->h1(e, 0));
+      // Under MPI each rank writes its own cells and facets (a piece of the .pvtu).
       for (unsigned int c = 0; c < network.cells.size(); ++c)
         for (const auto &loop : network.cells[c].outline)
           {
+            if (distributed() && cell_owner[c] != rank)
+              break;
             for (const auto &p : loop)
               add_point(p, c);
             offsets.push_back(connectivity.size());
@@ -241,6 +254,8 @@ namespace hysteron
       // H1 (the largest of its springs'); broken ones have broken = 1 and no force.
       for (unsigned int e = 0; e < springs.size(); ++e)
         {
+          if (distributed() && !owned_facet[e])
+            continue;
           const Springs &sp = springs[e];
           const Facet   &f  = network.facets[e];
           add_point(f.p3, f.a);
@@ -290,23 +305,13 @@ namespace hysteron
         displacement_3d.insert(displacement_3d.end(), {displacement[2 * k], displacement[2 * k + 1], 0.0});
       array("Float64", "displacement", 3, displacement_3d);
       out << "</PointData>\n<CellData>\n";
-      const auto integers = [&](const char *name, const std::vector<int> &values) {
-        array("Int32", name, 1, std::vector<std::int32_t>(values.begin(), values.end()));
-      };
-      const auto reals = [&](const char *name, const std::vector<double> &values) {
-        array("Float64", name, 1, values);
-      };
-      integers("cell", cell_index);
-      integers("facet", facet_index);
-      integers("body", body);
-      integers("broken", broken);
-      integers("fragment", part);
-      integers("released", loose);
-      reals("rotation", theta);
-      reals("H1", h1);
-      const char *force_names[5] = {"f_n", "f_t", "m", "s_n", "s_t"};
-      for (unsigned int k = 0; k < 5; ++k)
-        reals(force_names[k], forces[k]);
+      const std::vector<const std::vector<int> *>    integers{&cell_index, &facet_index, &body, &broken, &part, &loose};
+      const std::vector<const std::vector<double> *> reals{&theta, &h1, &forces[0], &forces[1], &forces[2], &forces[3], &forces[4]};
+      for (unsigned int k = 0; k < vtu_cell_fields.size(); ++k)
+        if (k < integers.size())
+          array("Int32", vtu_cell_fields[k], 1, std::vector<std::int32_t>(integers[k]->begin(), integers[k]->end()));
+        else
+          array("Float64", vtu_cell_fields[k], 1, *reals[k - integers.size()]);
       out << "</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
     }
 
@@ -315,7 +320,27 @@ namespace hysteron
     void
     Model::write_fields(const double t, Output::FieldWriter &writer)
     {
-      writer.write_serial([this](std::ostream &out) { write_vtu(out); }, t);
+      if (!distributed())
+        return writer.write_serial([this](std::ostream &out) { write_vtu(out); }, t); // replicated
+      writer.write_pieces([this](std::ostream &out) { write_vtu(out); },
+                          [](std::ostream &out, const std::vector<std::string> &pieces) {
+                            // The record of the ranks' pieces: the arrays of write_vtu().
+                            out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" "
+                                   "version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+                                   "<PUnstructuredGrid GhostLevel=\"0\">\n<PPointData "
+                                   "Vectors=\"displacement\">\n<PDataArray type=\"Float64\" "
+                                   "Name=\"displacement\" NumberOfComponents=\"3\"/>\n</PPointData>\n"
+                                   "<PCellData>\n";
+                            for (unsigned int k = 0; k < vtu_cell_fields.size(); ++k)
+                              out << "<PDataArray type=\"" << (k < 6 ? "Int32" : "Float64")
+                                  << "\" Name=\"" << vtu_cell_fields[k] << "\" NumberOfComponents=\"1\"/>\n";
+                            out << "</PCellData>\n<PPoints>\n<PDataArray type=\"Float64\" "
+                                   "NumberOfComponents=\"3\"/>\n</PPoints>\n";
+                            for (const auto &piece : pieces)
+                              out << "<Piece Source=\"" << piece << "\"/>\n";
+                            out << "</PUnstructuredGrid>\n</VTKFile>\n";
+                          },
+                          t);
     }
 
 

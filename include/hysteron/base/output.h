@@ -193,10 +193,22 @@ namespace hysteron
 
       /**
        * A VTU file that @p writer produces whole (a method's own cells, e.g. the
-       * RBSN's polygons): written by rank 0 as "<base>-<step>.vtu", then the PVD.
+       * RBSN's polygons, the same on every rank): written by rank 0 as
+       * "<base>-<step>.vtu", then the PVD.
        */
       void
       write_serial(const std::function<void(std::ostream &)> &writer, double time);
+
+      /**
+       * A field that a method writes itself (e.g. the RBSN's polygons): on one rank
+       * @p piece writes "<base>-<step>.vtu"; on several, every rank writes its piece
+       * "<base>-<step>.<rank>.vtu" and rank 0 the record "<base>-<step>.pvtu" with
+       * @p record (given the pieces' names). Then the PVD. write() is this with DataOut.
+       */
+      void
+      write_pieces(const std::function<void(std::ostream &)>                                   &piece,
+                   const std::function<void(std::ostream &, const std::vector<std::string> &)> &record,
+                   double                                                                      time);
 
       /// The (time, file) list written so far.
       const std::vector<std::pair<double, std::string>> &
