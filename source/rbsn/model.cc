@@ -100,14 +100,15 @@ namespace hysteron
                           "Newton, more iterations with far fewer factorizations; the converged "
                           "result is the same (same residual tolerance).");
         prm.declare_entry("Distributed direct solver",
-                          "Amesos_Klu",
-                          Patterns::Selection("Amesos_Klu|Amesos_Mumps"),
+                          "UMFPACK",
+                          Patterns::Selection("UMFPACK|Amesos_Klu|Amesos_Mumps"),
                           "Under mpirun (more than one rank) the cells are split over the ranks "
-                          "(METIS) and the distributed tangent goes to this Trilinos Amesos "
-                          "solver: Amesos_Klu (the default) gathers it and factorizes on one rank, "
-                          "so that a run on N ranks is reproducible bit for bit; Amesos_Mumps "
-                          "factorizes in parallel (faster on large networks), but its results vary "
-                          "at round-off from run to run. Both are refined iteratively.");
+                          "(METIS), each rank assembles its facets, and the distributed tangent "
+                          "goes to: UMFPACK (the default: gathered on rank 0 and factorized there "
+                          "with the symbolic analysis kept, as on one rank; reproducible bit for "
+                          "bit), Amesos_Klu (Trilinos, gathered on one rank; reproducible) or "
+                          "Amesos_Mumps (factorized in parallel; its results vary at round-off "
+                          "from run to run). The Amesos solves are refined iteratively."),
         prm.declare_entry("Linear solver",
                           "direct",
                           Patterns::Selection("direct|cg|gmres"),
@@ -446,7 +447,9 @@ namespace hysteron
     {
       const unsigned int n = 3 * network.cells.size();
       partition();
-      if (!trilinos_system())
+      // The serial matrix: one rank, or rank 0 under the gathered UMFPACK solver.
+      if (!trilinos_system() ||
+          (distributed() && linear_solver == "direct" && distributed_solver == "UMFPACK" && rank == 0))
         {
           dealii::DynamicSparsityPattern dsp(n, n);
           for (unsigned int c = 0; c < network.cells.size(); ++c)

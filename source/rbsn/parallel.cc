@@ -3,7 +3,8 @@
 // The work is shared: the cells are partitioned over the ranks by METIS on the
 // cell graph (a facet belongs to the owner of its first cell), each rank
 // evaluates the spring laws of its facets and assembles them into a distributed
-// Trilinos matrix, which Amesos factorizes (KLU on one rank, or MUMPS in parallel). After every converged step
+// Trilinos matrix, which is factorized by UMFPACK on rank 0 (gathered) or by
+// Trilinos Amesos (KLU on one rank, or MUMPS in parallel). After every converged step
 // the facets' states go from their owners to every rank, so that outputs,
 // fracture, fragments and checkpoints see the whole network on every rank.
 #include <deal.II/base/mpi.h>
@@ -19,6 +20,8 @@
 #include <deal.II/lac/trilinos_vector.h>
 
 #include <hysteron/rbsn/model.h>
+
+#include "base/sparse_lu.h"
 
 #include <Epetra_CrsMatrix.h>
 
@@ -225,6 +228,8 @@ namespace hysteron
         d(owned_dofs, comm);
       if (linear_solver != "direct")
         return solve_iterative(x, change, slow);
+      if (distributed_solver == "UMFPACK")
+        return solve_gathered(x, change, slow);
       try
         {
           if (!(change <= reuse_tolerance) || slow)
@@ -268,6 +273,84 @@ namespace hysteron
       for (const auto i : owned_dofs)
         x(i) = y(i);
       sum_over_ranks(x);
+    }
+
+
+
+    void
+    Model::solve_gathered(Vector &x, const double change, const bool slow)
+    {
+      using namespace dealii;
+      const MPI_Comm comm = scene.mpi_communicator();
+      const bool     refactorize = !(change <= reuse_tolerance) || slow;
+      if (refactorize)
+        {
+          // Every rank's rows (global row, length, then column and value pairs) to rank 0,
+          // which fills the serial matrix and factorizes it with the kept symbolic analysis.
+          std::vector<double>     rows;
+          const Epetra_CrsMatrix &A = parallel_matrix.trilinos_matrix();
+          for (int i = 0; i < A.NumMyRows(); ++i)
+            {
+              int     n = 0;
+              double *values = nullptr;
+              int    *columns = nullptr;
+              A.ExtractMyRowView(i, n, values, columns);
+              rows.push_back(TrilinosWrappers::global_index(A.RowMap(), i));
+              rows.push_back(n);
+              for (int k = 0; k < n; ++k)
+                {
+                  rows.push_back(TrilinosWrappers::global_index(A.ColMap(), columns[k]));
+                  rows.push_back(values[k]);
+                }
+            }
+          int              n_mine = rows.size();
+          std::vector<int> counts(n_ranks), offsets(n_ranks, 0);
+          int ierr = MPI_Gather(&n_mine, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
+          AssertThrowMPI(ierr);
+          for (unsigned int r = 1; r < n_ranks; ++r)
+            offsets[r] = offsets[r - 1] + counts[r - 1];
+          std::vector<double> all(rank == 0 ? offsets.back() + counts.back() : 0);
+          ierr = MPI_Gatherv(rows.data(), n_mine, MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
+                             MPI_DOUBLE, 0, comm);
+          AssertThrowMPI(ierr);
+          int singular = 0;
+          if (rank == 0)
+            {
+              matrix = 0;
+              for (std::size_t p = 0; p < all.size();)
+                {
+                  const auto row = static_cast<types::global_dof_index>(all[p]);
+                  const auto n   = static_cast<std::size_t>(all[p + 1]);
+                  for (std::size_t k = 0; k < n; ++k)
+                    matrix.set(row, static_cast<types::global_dof_index>(all[p + 2 + 2 * k]), all[p + 3 + 2 * k]);
+                  p += 2 + 2 * n;
+                }
+              try
+                {
+                  direct->factorize(matrix);
+                }
+              catch (const std::runtime_error &)
+                {
+                  singular = 1;
+                }
+            }
+          ierr = MPI_Bcast(&singular, 1, MPI_INT, 0, comm);
+          AssertThrowMPI(ierr);
+          if (singular)
+            throw RuntimeError("rbsn: the tangent stiffness matrix is singular: the network is a "
+                               "mechanism (springs without stiffness, e.g. perfectly plastic ones "
+                               "at their limit, or a part that only such springs hold)");
+          factored_parallel.copy_from(parallel_matrix);
+          factorized = true;
+          ++n_factorizations;
+        }
+      stale_factors     = !refactorize && change > 0;
+      previous_residual = rhs.l2_norm();
+      // The right-hand side is replicated: rank 0 solves and sends the solution.
+      if (rank == 0)
+        direct->solve(x, rhs);
+      const int ierr = MPI_Bcast(x.data(), x.size(), MPI_DOUBLE, 0, comm);
+      AssertThrowMPI(ierr);
     }
 
 

@@ -228,7 +228,7 @@ namespace hysteron
 
       // MPI (parallel.cc): the cells are partitioned over the ranks (METIS on the cell
       // graph); each rank evaluates the springs of its facets and assembles them into a
-      // distributed Trilinos matrix, solved by Amesos (KLU or MUMPS). The network, the DoF vectors and
+      // distributed Trilinos matrix, solved by UMFPACK on rank 0 or Amesos (KLU, MUMPS). The network, the DoF vectors and
       // (after every step) the springs' state are replicated on every rank.
       /// More than one MPI rank.
       bool
@@ -258,6 +258,10 @@ namespace hysteron
       /// factors would be (@p change of the matrix, @p slow convergence of Newton).
       void
       solve_iterative(Vector &x, double change, bool slow);
+      /// solve_distributed() with `Distributed direct solver = UMFPACK`: the matrix gathered
+      /// on rank 0 and factorized there (SparseLU), the solution sent to every rank.
+      void
+      solve_gathered(Vector &x, double change, bool slow);
       /// Add a local matrix and vector through the constraints to the system of this rank.
       void
       add_local(const dealii::FullMatrix<double>                     &K,
