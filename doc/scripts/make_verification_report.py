@@ -240,7 +240,9 @@ def measure(work, jobs):
         (f[i] - f[i - 1]) / (u[i] - u[i - 1]) / k_n for i in range(1, len(f))
         if h[i] > 0.999 and h[i - 1] > 0.999 and (f[i] - f[i - 1]) * (u[i] - u[i - 1]) > 0)
     c = out("rbsn_single_element_fracture", "probe_0.csv")
-    m["sf_yield"] = (c["f_n"][-1] - 0.02 * 2.3077e9 * c["u_x"][-1]) / 0.98 / 1e3
+    # The last row before the break (the cell is released after it and its facet has no force).
+    i = max(k for k, b in enumerate(c["broken"]) if b == 0)
+    m["sf_yield"] = (c["f_n"][i] - 0.02 * 2.3077e9 * c["u_x"][i]) / 0.98 / 1e3
     m["sf_break"] = 1400 * out("rbsn_single_element_fracture", "fracture.csv")["time"][0]
 
     rows = markdown_rows(os.path.join(work, "studies", "cantilever_mesh_study.md"))
