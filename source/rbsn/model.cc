@@ -700,6 +700,16 @@ namespace hysteron
 
 
 
+    RuntimeError
+    Model::singular_tangent()
+    {
+      return RuntimeError("rbsn: the tangent stiffness matrix is singular: the network is a "
+                          "mechanism (springs without stiffness, e.g. perfectly plastic ones at "
+                          "their limit, or a part that only such springs hold)");
+    }
+
+
+
     void
     Model::solve_linear(Vector &x)
     {
@@ -738,9 +748,7 @@ namespace hysteron
         }
       catch (const std::runtime_error &)
         {
-          throw RuntimeError("rbsn: the tangent stiffness matrix is singular: the network is a "
-                             "mechanism (springs without stiffness, e.g. perfectly plastic ones "
-                             "at their limit, or a part that only such springs hold)");
+          throw singular_tangent();
         }
     }
 

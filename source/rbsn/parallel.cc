@@ -224,12 +224,12 @@ namespace hysteron
           change = std::sqrt(sums[0] / sums[1]);
         }
       const bool slow = stale_factors && residual > 0.5 * previous_residual;
-      TrilinosWrappers::MPI::Vector b(owned_dofs, comm), y(owned_dofs, comm), r(owned_dofs, comm),
-        d(owned_dofs, comm);
       if (linear_solver != "direct")
         return solve_iterative(x, change, slow);
       if (distributed_solver == "UMFPACK")
         return solve_gathered(x, change, slow);
+      TrilinosWrappers::MPI::Vector b(owned_dofs, comm), y(owned_dofs, comm), r(owned_dofs, comm),
+        d(owned_dofs, comm);
       try
         {
           if (!(change <= reuse_tolerance) || slow)
@@ -265,9 +265,7 @@ namespace hysteron
         }
       catch (const ExceptionBase &)
         {
-          throw RuntimeError("rbsn: the tangent stiffness matrix is singular: the network is a "
-                             "mechanism (springs without stiffness, e.g. perfectly plastic ones "
-                             "at their limit, or a part that only such springs hold)");
+          throw singular_tangent();
         }
       x = 0;
       for (const auto i : owned_dofs)
@@ -337,9 +335,7 @@ namespace hysteron
           ierr = MPI_Bcast(&singular, 1, MPI_INT, 0, comm);
           AssertThrowMPI(ierr);
           if (singular)
-            throw RuntimeError("rbsn: the tangent stiffness matrix is singular: the network is a "
-                               "mechanism (springs without stiffness, e.g. perfectly plastic ones "
-                               "at their limit, or a part that only such springs hold)");
+            throw singular_tangent();
           factored_parallel.copy_from(parallel_matrix);
           factorized = true;
           ++n_factorizations;

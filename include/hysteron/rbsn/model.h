@@ -225,6 +225,9 @@ namespace hysteron
       commit(const double dt, const bool broke);
       void
       solve_linear(Vector &x);
+      /// The error of a singular tangent (every solver's).
+      static RuntimeError
+      singular_tangent();
 
       // MPI (parallel.cc): the cells are partitioned over the ranks (METIS on the cell
       // graph); each rank evaluates the springs of its facets and assembles them into a
