@@ -1,4 +1,6 @@
 #include <deal.II/base/utilities.h>
+
+#include <Epetra_CrsMatrix.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 
 #include <hysteron/base/parameters.h>
@@ -700,6 +702,54 @@ namespace hysteron
 
 
 
+    bool
+    Model::renew_factors()
+    {
+      // Refactorize only on change: an unchanged tangent (elastic steps, static analyses)
+      // keeps its factors; with a reuse tolerance, a tangent within it of the factorized
+      // one too (modified Newton), unless the last correction with stale factors reduced
+      // the residual less than twofold. The change is ||K - K_f||_F / ||K_f||_F against the
+      // copy K_f kept at the last factorization (summed over the ranks' rows).
+      double change = std::numeric_limits<double>::infinity();
+      if (factorized)
+        {
+          double sums[2] = {0, 0}; // ||K - K_f||^2, ||K_f||^2
+          const auto add = [&](const double k, const double f) {
+            sums[0] += (k - f) * (k - f);
+            sums[1] += f * f;
+          };
+          if (trilinos_system())
+            {
+              // The two matrices share their graph (copy_from): compare the local rows.
+              const Epetra_CrsMatrix &A = parallel_matrix.trilinos_matrix(),
+                                     &F = factored_parallel.trilinos_matrix();
+              for (int row = 0; row < A.NumMyRows(); ++row)
+                {
+                  int     n_a = 0, n_f = 0;
+                  double *a = nullptr, *f = nullptr;
+                  A.ExtractMyRowView(row, n_a, a);
+                  F.ExtractMyRowView(row, n_f, f);
+                  for (int k = 0; k < std::min(n_a, n_f); ++k)
+                    add(a[k], f[k]);
+                }
+              const int ierr = MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, scene.mpi_communicator());
+              AssertThrowMPI(ierr);
+            }
+          else
+            for (auto p = matrix.begin(), q = factored_matrix.begin(); p != matrix.end(); ++p, ++q)
+              add(p->value(), q->value());
+          change = std::sqrt(sums[0] / sums[1]);
+        }
+      const double residual = rhs.l2_norm();
+      const bool   slow     = stale_factors && residual > 0.5 * previous_residual;
+      const bool   renew    = !(change <= reuse_tolerance) || slow;
+      stale_factors         = !renew && change > 0;
+      previous_residual     = residual;
+      return renew;
+    }
+
+
+
     RuntimeError
     Model::singular_tangent()
     {
@@ -715,35 +765,15 @@ namespace hysteron
     {
       if (trilinos_system())
         return solve_distributed(x);
-      // Refactorize only on change: an unchanged tangent (elastic steps, static analyses)
-      // keeps its factors; with a reuse tolerance, a tangent within it of the factorized
-      // one too (modified Newton), unless the last correction with stale factors reduced
-      // the residual less than twofold.
-      const double residual = rhs.l2_norm();
-      double       change   = std::numeric_limits<double>::infinity();
-      if (factorized)
-        {
-          double difference = 0, norm = 0;
-          for (auto p = matrix.begin(), q = factored_matrix.begin(); p != matrix.end(); ++p, ++q)
-            {
-              difference += (p->value() - q->value()) * (p->value() - q->value());
-              norm += q->value() * q->value();
-            }
-          change = std::sqrt(difference / norm);
-        }
-      const bool slow = stale_factors && residual > 0.5 * previous_residual;
       try
         {
-          if (!(change <= reuse_tolerance) || slow)
+          if (renew_factors())
             {
               direct->factorize(matrix);
               factored_matrix.copy_from(matrix);
               factorized = true;
               ++n_factorizations;
-              change = 0;
             }
-          stale_factors     = change > 0;
-          previous_residual = residual;
           direct->solve(x, rhs);
         }
       catch (const std::runtime_error &)

@@ -199,40 +199,16 @@ namespace hysteron
     {
       using namespace dealii;
       const MPI_Comm comm = scene.mpi_communicator();
-      // Refactorize on change, as solve_linear() (the change summed over the ranks' rows).
-      const double residual = rhs.l2_norm();
-      double       change   = std::numeric_limits<double>::infinity();
-      if (factorized)
-        {
-          // The two matrices share their graph (copy_from): compare the local rows' values.
-          double                  sums[2] = {0, 0};
-          const Epetra_CrsMatrix &A = parallel_matrix.trilinos_matrix(), &F = factored_parallel.trilinos_matrix();
-          for (int row = 0; row < A.NumMyRows(); ++row)
-            {
-              int     n_a = 0, n_f = 0;
-              double *a = nullptr, *f = nullptr;
-              A.ExtractMyRowView(row, n_a, a);
-              F.ExtractMyRowView(row, n_f, f);
-              for (int k = 0; k < std::min(n_a, n_f); ++k)
-                {
-                  sums[0] += (a[k] - f[k]) * (a[k] - f[k]);
-                  sums[1] += f[k] * f[k];
-                }
-            }
-          const int ierr = MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, comm);
-          AssertThrowMPI(ierr);
-          change = std::sqrt(sums[0] / sums[1]);
-        }
-      const bool slow = stale_factors && residual > 0.5 * previous_residual;
+      const bool renew = renew_factors();
       if (linear_solver != "direct")
-        return solve_iterative(x, change, slow);
+        return solve_iterative(x, renew);
       if (distributed_solver == "UMFPACK")
-        return solve_gathered(x, change, slow);
+        return solve_gathered(x, renew);
       TrilinosWrappers::MPI::Vector b(owned_dofs, comm), y(owned_dofs, comm), r(owned_dofs, comm),
         d(owned_dofs, comm);
       try
         {
-          if (!(change <= reuse_tolerance) || slow)
+          if (renew)
             {
               // The factors belong to a copy, so that the assembly can go on in parallel_matrix.
               factored_parallel.copy_from(parallel_matrix);
@@ -241,10 +217,7 @@ namespace hysteron
               parallel_direct->initialize(factored_parallel);
               factorized = true;
               ++n_factorizations;
-              change = 0;
             }
-          stale_factors     = change > 0;
-          previous_residual = residual;
           for (const auto i : owned_dofs)
             b(i) = rhs(i);
           b.compress(VectorOperation::insert);
@@ -276,12 +249,11 @@ namespace hysteron
 
 
     void
-    Model::solve_gathered(Vector &x, const double change, const bool slow)
+    Model::solve_gathered(Vector &x, const bool renew)
     {
       using namespace dealii;
       const MPI_Comm comm = scene.mpi_communicator();
-      const bool     refactorize = !(change <= reuse_tolerance) || slow;
-      if (refactorize)
+      if (renew)
         {
           // Every rank's rows (global row, length, then column and value pairs) to rank 0,
           // which fills the serial matrix and factorizes it with the kept symbolic analysis.
@@ -340,8 +312,6 @@ namespace hysteron
           factorized = true;
           ++n_factorizations;
         }
-      stale_factors     = !refactorize && change > 0;
-      previous_residual = rhs.l2_norm();
       // The right-hand side is replicated: rank 0 solves and sends the solution.
       if (rank == 0)
         direct->solve(x, rhs);
@@ -352,11 +322,11 @@ namespace hysteron
 
 
     void
-    Model::solve_iterative(Vector &x, const double change, const bool slow)
+    Model::solve_iterative(Vector &x, const bool renew)
     {
       using namespace dealii;
       const MPI_Comm comm = scene.mpi_communicator();
-      if (!(change <= reuse_tolerance) || slow || !amg)
+      if (renew || !amg)
         {
           // ML aggregation with the null space of the network: per cell the translations
           // (1, 0, 0), (0, 1, 0) and the rotation (-(y - y_0), x - x_0, 1) about the centre.
@@ -395,8 +365,6 @@ namespace hysteron
           factorized = true;
           ++n_factorizations;
         }
-      stale_factors     = !(change <= 0);
-      previous_residual = rhs.l2_norm();
       TrilinosWrappers::MPI::Vector b(owned_dofs, comm), y(owned_dofs, comm);
       for (const auto i : owned_dofs)
         b(i) = rhs(i);

@@ -225,6 +225,10 @@ namespace hysteron
       commit(const double dt, const bool broke);
       void
       solve_linear(Vector &x);
+      /// Whether the factors (or the AMG hierarchy) must be rebuilt for the current matrix:
+      /// the one refactorization policy of every solver (the caller then rebuilds them).
+      bool
+      renew_factors();
       /// The error of a singular tangent (every solver's).
       static RuntimeError
       singular_tangent();
@@ -257,14 +261,14 @@ namespace hysteron
       /// solve_linear() on the distributed matrix.
       void
       solve_distributed(Vector &x);
-      /// solve_distributed() with cg / gmres and ML: the preconditioner is rebuilt as the
-      /// factors would be (@p change of the matrix, @p slow convergence of Newton).
+      /// solve_distributed() with cg / gmres and ML: the preconditioner is rebuilt when
+      /// @p renew (renew_factors()).
       void
-      solve_iterative(Vector &x, double change, bool slow);
+      solve_iterative(Vector &x, bool renew);
       /// solve_distributed() with `Distributed direct solver = UMFPACK`: the matrix gathered
       /// on rank 0 and factorized there (SparseLU), the solution sent to every rank.
       void
-      solve_gathered(Vector &x, double change, bool slow);
+      solve_gathered(Vector &x, bool renew);
       /// Add a local matrix and vector through the constraints to the system of this rank.
       void
       add_local(const dealii::FullMatrix<double>                     &K,
