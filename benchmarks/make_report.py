@@ -20,6 +20,7 @@ Studies (name: script; minutes on the 2-core Xeon VM with --repeats 3):
   fem_plastic_error_vs_time    §5.1 plastic cantilever and §3.7.4 plate, FEM                  8
   rbsn_run_time                RBSN cantilever / titanium plate against cells                 4
   rbsn_large                   RBSN 100k-cell elastic plate, 10k-cell plastic cantilever      6
+  rbsn_incremental_assembly    RBSN tangent updated in place against assembled from zero       3
   rbsn_cantilever_plastic      §5.1 RBSN, uncoupled against coupled springs                   3
   rbsn_newmark_vs_variable_order  §3.6.1 element, Newmark against IDA                        3
   mpm_throughput               run_mpm_benchmark.py (M particle-steps/s, 2-rank efficiency)   3
@@ -93,6 +94,9 @@ def studies(args, out, work):
               py("rbsn_run_time.py", "--repeats", r, "--output", os.path.join(out, "rbsn_run_time"), *q), 4),
         Study("rbsn_large",
               py("rbsn_large.py", "--repeats", r, "--output", os.path.join(out, "rbsn_large"), *q), 6),
+        Study("rbsn_incremental_assembly",
+              py("rbsn_incremental_assembly.py", "--repeats", r, "--output",
+                 os.path.join(out, "rbsn_incremental_assembly"), *q), 3),
         Study("rbsn_cantilever_plastic",
               [PY, os.path.join(bench, "rbsn_cantilever_plastic.py"), os.path.join(b, "hysteron"),
                "--repeats", r, "--out", out, "--workdir", f"{work}/rbsn_cantilever"]

@@ -3,6 +3,8 @@
 // Every rank holds the whole network, so every rank writes (and reads) the same.
 #include <hysteron/rbsn/model.h>
 
+#include <Epetra_CrsMatrix.h>
+
 namespace hysteron
 {
   namespace RBSN
@@ -46,6 +48,17 @@ namespace hysteron
       out.section("rbsn fracture energy, factorizations");
       out.put(fracture_energy);
       out.put(n_factorizations);
+      // The incrementally assembled tangent: which facets' tangents it holds, and its values.
+      out.section("rbsn assembled tangent");
+      out.put(matrix_current);
+      out.put(matrix_dt);
+      out.put(incremental_updates);
+      if (matrix_current)
+        {
+          out.put(facet_in_matrix);
+          out.put(assembled_tangent);
+          out.put(matrix_values());
+        }
       tables.save(out);
     }
 
@@ -102,7 +115,75 @@ namespace hysteron
       in.get(fracture_energy);
       in.get(n_factorizations);
       update_fragments(); // from the broken facets
+      in.section("rbsn assembled tangent");
+      in.get(matrix_current);
+      in.get(matrix_dt);
+      in.get(incremental_updates);
+      if (matrix_current)
+        {
+          in.get(facet_in_matrix);
+          in.get(assembled_tangent);
+          std::vector<double> values;
+          in.get(values);
+          if (facet_in_matrix.size() != springs.size() || assembled_tangent.size() != springs.size())
+            throw RuntimeError("the checkpoint's assembled tangent does not match the network");
+          set_matrix_values(values);
+        }
       tables.load(in);
+    }
+
+
+
+    std::vector<double>
+    Model::matrix_values() const
+    {
+      std::vector<double> values;
+      if (trilinos_system())
+        {
+          const Epetra_CrsMatrix &A = parallel_matrix.trilinos_matrix();
+          for (int row = 0; row < A.NumMyRows(); ++row)
+            {
+              int     n = 0;
+              double *a = nullptr;
+              A.ExtractMyRowView(row, n, a);
+              values.insert(values.end(), a, a + n);
+            }
+        }
+      else
+        for (const auto &entry : matrix)
+          values.push_back(entry.value());
+      return values;
+    }
+
+
+
+    void
+    Model::set_matrix_values(const std::vector<double> &values)
+    {
+      // The pattern is rebuilt by set-up as it was: the values go back in the same order.
+      std::size_t k = 0;
+      const auto  next = [&]() {
+        if (k >= values.size())
+          throw RuntimeError("the checkpoint's tangent matrix does not match the network's pattern");
+        return values[k++];
+      };
+      if (trilinos_system())
+        {
+          const Epetra_CrsMatrix &A = parallel_matrix.trilinos_matrix();
+          for (int row = 0; row < A.NumMyRows(); ++row)
+            {
+              int     n = 0;
+              double *a = nullptr;
+              A.ExtractMyRowView(row, n, a);
+              for (int j = 0; j < n; ++j)
+                a[j] = next();
+            }
+        }
+      else
+        for (auto &entry : matrix)
+          entry.value() = next();
+      if (k != values.size())
+        throw RuntimeError("the checkpoint's tangent matrix does not match the network's pattern");
     }
   } // namespace RBSN
 } // namespace hysteron

@@ -195,6 +195,51 @@ namespace hysteron
 
 
     void
+    Model::add_local_rhs(const dealii::FullMatrix<double>                     &K,
+                         const dealii::Vector<double>                         &r,
+                         const std::vector<dealii::types::global_dof_index> &dofs)
+    {
+      // Free rows: r less the columns of the prescribed increments g (-K g).
+      constraints.distribute_local_to_global(r, dofs, rhs, K);
+      if (!constraints.has_inhomogeneities())
+        return;
+      // A constrained row gets its diagonal times g, as the assembly with the matrix gives
+      // it (K_ii, or the mean |K_ii| of the local matrix where K_ii = 0): the predictor's
+      // force level does not depend on how the matrix was assembled.
+      const unsigned int n    = dofs.size();
+      double             mean = 0;
+      for (unsigned int i = 0; i < n; ++i)
+        mean += std::abs(K(i, i));
+      mean /= n;
+      if (mean == 0)
+        mean = K.l1_norm() / n;
+      if (mean == 0)
+        mean = 1;
+      for (unsigned int i = 0; i < n; ++i)
+        if (constraints.is_constrained(dofs[i]))
+          rhs(dofs[i]) += (K(i, i) != 0 ? K(i, i) : mean) * constraints.get_inhomogeneity(dofs[i]);
+    }
+
+
+
+    void
+    Model::add_local_change(dealii::FullMatrix<double> &K, const std::vector<dealii::types::global_dof_index> &dofs)
+    {
+      // The constrained rows and columns are empty but for the diagonal of the last full
+      // assembly, which they keep.
+      for (unsigned int i = 0; i < dofs.size(); ++i)
+        if (constraints.is_constrained(dofs[i]))
+          for (unsigned int j = 0; j < dofs.size(); ++j)
+            K(i, j) = K(j, i) = 0;
+      if (trilinos_system())
+        parallel_matrix.add(dofs, K);
+      else
+        matrix.add(dofs, K);
+    }
+
+
+
+    void
     Model::solve_distributed(Vector &x)
     {
       using namespace dealii;

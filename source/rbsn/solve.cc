@@ -3,6 +3,7 @@
 #include <hysteron/rbsn/model.h>
 #include <hysteron/run/stepping_method.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -32,25 +33,84 @@ namespace hysteron
     {
       const bool   dynamic = analysis == Analysis::implicit_dynamics && dt > 0;
       const double alpha = dynamics.hht_alpha, beta = dynamics.beta(), gamma = dynamics.gamma();
-      if (with_matrix && trilinos_system())
-        parallel_matrix = 0;
-      else if (with_matrix)
-        matrix = 0;
+      // The matrix is updated rather than rebuilt if it holds the facets' tangents for the
+      // current constrained DoFs and (dynamics) the same step.
+      const double key         = dynamic ? dt : 0.0;
+      const bool   incremental = with_matrix && incremental_assembly && matrix_current && matrix_dt == key &&
+                               incremental_updates < max_incremental_updates;
+      if (with_matrix)
+        {
+          ++n_matrix_assemblies;
+          if (incremental)
+            ++incremental_updates;
+          else
+            {
+              ++n_full_assemblies;
+              incremental_updates = 0;
+              if (trilinos_system())
+                parallel_matrix = 0;
+              else
+                matrix = 0;
+              assembled_tangent.resize(springs.size());
+              facet_in_matrix.assign(springs.size(), false);
+            }
+          matrix_current = true;
+          matrix_dt      = key;
+        }
       rhs     = 0;
       f_int   = 0;
       inertia = 0;
       external_forces(t1, f_ext);
 
-      dealii::FullMatrix<double>                K(6, 6), K0(6, 6);
+      dealii::FullMatrix<double>                K(6, 6), K_old(6, 6), K0(6, 6);
       dealii::Vector<double>                    r(6), fe(6), fe0(6), ue(6), ve0(6), ve1(6), tmp(6);
       std::vector<dealii::types::global_dof_index> dofs(6);
       bool        failed = false;
       std::string message;
       const bool  diagonal_law = spring_law->diagonal_tangent();
+      // K0 = B^T diag(k) B: the elastic springs (stiffness-proportional damping).
+      const auto elastic_matrix = [](const Springs &sp, dealii::FullMatrix<double> &M) {
+        for (unsigned int p = 0; p < 6; ++p)
+          for (unsigned int q = 0; q < 6; ++q)
+            {
+              M(p, q) = 0;
+              for (unsigned int i = 0; i < 3; ++i)
+                M(p, q) += sp.B(i, p) * sp.k[i] * sp.B(i, q);
+            }
+      };
+      // The facet's matrix for the tangent D: B^T D B (the diagonal of D only, for linear
+      // springs and laws of independent springs; else the full, not necessarily symmetric
+      // D); in dynamics (1 + alpha) B^T D B + (1 + alpha) gamma / (beta dt) a1 K0.
+      const auto facet_matrix = [&](const Springs &sp, const SpringLaw::Matrix &D, dealii::FullMatrix<double> &M) {
+        const bool diagonal = diagonal_law || !sp.hysteretic;
+        for (unsigned int p = 0; p < 6; ++p)
+          for (unsigned int q = 0; q < 6; ++q)
+            {
+              M(p, q) = 0;
+              for (unsigned int i = 0; i < 3; ++i)
+                if (diagonal)
+                  M(p, q) += sp.B(i, p) * D[i][i] * sp.B(i, q);
+                else
+                  for (unsigned int j = 0; j < 3; ++j)
+                    M(p, q) += sp.B(i, p) * D[i][j] * sp.B(j, q);
+            }
+        if (dynamic)
+          {
+            M *= 1 + alpha;
+            if (dynamics.rayleigh_stiffness > 0)
+              {
+                elastic_matrix(sp, K0);
+                M.add((1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_stiffness, K0);
+              }
+          }
+      };
+      const auto any_constrained = [&](const std::vector<dealii::types::global_dof_index> &indices) {
+        return std::any_of(indices.begin(), indices.end(), [&](const auto i) { return constraints.is_constrained(i); });
+      };
       for (unsigned int e = 0; e < springs.size(); ++e)
         {
           Springs &sp = springs[e];
-          if (sp.broken || (distributed() && !owned_facet[e]))
+          if (distributed() && !owned_facet[e])
             continue;
           const Facet &f = network.facets[e];
           for (unsigned int k = 0; k < 3; ++k)
@@ -58,9 +118,21 @@ namespace hysteron
               dofs[k]     = 3 * f.a + k;
               dofs[3 + k] = 3 * f.b + k;
             }
+          if (sp.broken)
+            {
+              // Broken since the matrix was assembled: its springs are taken out of it.
+              if (incremental && facet_in_matrix[e])
+                {
+                  facet_matrix(sp, assembled_tangent[e], K);
+                  K *= -1.0;
+                  add_local_change(K, dofs);
+                  facet_in_matrix[e] = false;
+                  ++n_facet_updates;
+                }
+              continue;
+            }
           for (unsigned int k = 0; k < 6; ++k)
             ue[k] = u_trial(dofs[k]);
-          const auto row = [&](const unsigned int i, const unsigned int k) { return sp.B(i, k); };
           SpringLaw::Vector increment;
           for (unsigned int i = 0; i < 3; ++i)
             {
@@ -98,26 +170,8 @@ namespace hysteron
             {
               fe[k] = 0;
               for (unsigned int i = 0; i < 3; ++i)
-                fe[k] += row(i, k) * sp.trial_force[i];
+                fe[k] += sp.B(i, k) * sp.trial_force[i];
             }
-          if (with_matrix && (diagonal_law || !sp.hysteretic))
-            for (unsigned int p = 0; p < 6; ++p)
-              for (unsigned int q = 0; q < 6; ++q)
-                {
-                  K(p, q) = 0;
-                  for (unsigned int i = 0; i < 3; ++i)
-                    K(p, q) += row(i, p) * sp.tangent[i][i] * row(i, q);
-                }
-          else if (with_matrix)
-            for (unsigned int p = 0; p < 6; ++p)
-              for (unsigned int q = 0; q < 6; ++q)
-                {
-                  // B^T D_t B with the full (not necessarily symmetric) D_t.
-                  K(p, q) = 0;
-                  for (unsigned int i = 0; i < 3; ++i)
-                    for (unsigned int j = 0; j < 3; ++j)
-                      K(p, q) += row(i, p) * sp.tangent[i][j] * row(j, q);
-                }
           r = fe;
           if (dynamic)
             {
@@ -126,21 +180,13 @@ namespace hysteron
                 {
                   fe0[k] = 0;
                   for (unsigned int i = 0; i < 3; ++i)
-                    fe0[k] += row(i, k) * sp.force[i];
+                    fe0[k] += sp.B(i, k) * sp.force[i];
                 }
               r *= 1 + alpha;
               r.add(-alpha, fe0);
-              if (with_matrix)
-                K *= 1 + alpha;
               if (dynamics.rayleigh_stiffness > 0)
                 {
-                  for (unsigned int p = 0; p < 6; ++p)
-                    for (unsigned int q = 0; q < 6; ++q)
-                      {
-                        K0(p, q) = 0;
-                        for (unsigned int i = 0; i < 3; ++i)
-                          K0(p, q) += row(i, p) * sp.k[i] * row(i, q);
-                      }
+                  elastic_matrix(sp, K0);
                   for (unsigned int k = 0; k < 6; ++k)
                     {
                       ve0[k]          = v(dofs[k]);
@@ -154,17 +200,50 @@ namespace hysteron
                     inertia(dofs[k]) += dynamics.rayleigh_stiffness * tmp[k];
                   K0.vmult(tmp, ve0);
                   r.add(-alpha * dynamics.rayleigh_stiffness, tmp);
-                  if (with_matrix)
-                    K.add((1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_stiffness, K0);
                 }
             }
           for (unsigned int k = 0; k < 6; ++k)
             f_int(dofs[k]) += fe[k];
           r *= -1.0;
-          add_local(K, r, dofs, with_matrix);
+          if (!with_matrix)
+            {
+              add_local(K, r, dofs, false);
+              continue;
+            }
+          ++n_facet_evaluations;
+          if (!incremental)
+            {
+              facet_matrix(sp, sp.tangent, K);
+              add_local(K, r, dofs, true);
+            }
+          else
+            {
+              // Only a facet whose tangent changed adds to the matrix: the difference of
+              // its new and assembled parts. Its matrix is needed for the right-hand side
+              // where it meets prescribed DoFs.
+              const bool changed     = !facet_in_matrix[e] || sp.tangent != assembled_tangent[e];
+              const bool constrained = any_constrained(dofs);
+              if (changed || constrained)
+                facet_matrix(sp, sp.tangent, K);
+              if (constrained)
+                add_local_rhs(K, r, dofs);
+              else
+                add_local(K, r, dofs, false);
+              if (!changed)
+                continue;
+              if (facet_in_matrix[e])
+                {
+                  facet_matrix(sp, assembled_tangent[e], K_old);
+                  K.add(-1.0, K_old);
+                }
+              add_local_change(K, dofs);
+            }
+          assembled_tangent[e] = sp.tangent;
+          facet_in_matrix[e]   = true;
+          ++n_facet_updates;
         }
 
-      if (with_matrix && !dynamic && !lone_cells.empty())
+      if (with_matrix && !incremental && !dynamic && !lone_cells.empty())
         {
           // A cell without an intact facet (constrained: released or held in full) has
           // no matrix entry: a diagonal of the springs' scale keeps the matrix regular.
@@ -184,7 +263,8 @@ namespace hysteron
 
       if (dynamic)
         {
-          // The cells: M a1 + (1 + alpha) a0 M v1 - alpha a0 M v0, tangent c_M M.
+          // The cells: M a1 + (1 + alpha) a0 M v1 - alpha a0 M v0, tangent c_M M (which an
+          // incremental assembly already holds).
           dealii::FullMatrix<double>                   M(3, 3);
           dealii::Vector<double>                       a1(3), v1(3), v0(3), rc(3), Mx(3);
           std::vector<dealii::types::global_dof_index> cd(3);
@@ -212,7 +292,10 @@ namespace hysteron
               rc *= -1.0;
               dealii::FullMatrix<double> A(3, 3);
               A.add(c_M, M);
-              add_local(A, rc, cd, with_matrix);
+              if (incremental && any_constrained(cd))
+                add_local_rhs(A, rc, cd);
+              else
+                add_local(A, rc, cd, with_matrix && !incremental);
             }
         }
 
@@ -456,6 +539,7 @@ namespace hysteron
         if (dof_set[i] >= 0)
           v(i) = prescribed_velocity(dirichlet[dof_set[i]], i, 0);
       make_constraints(0, 0, false);
+      matrix_current = false; // the mass matrix alone
       if (trilinos_system())
         parallel_matrix = 0;
       else

@@ -98,6 +98,9 @@ namespace hysteron
     void
     Model::update_fragments()
     {
+      // A change of the released or lone cells (their DoFs' constraints) rebuilds the matrix.
+      const std::vector<bool>         released_before = released;
+      const std::vector<unsigned int> lone_before     = lone_cells;
       const auto free = network_parts(true, fragment);
       n_fragments     = free.size();
       // Dynamics: a loose fragment moves under its inertia; nothing is released.
@@ -117,6 +120,8 @@ namespace hysteron
             released[c] = true;
             ++n_released;
           }
+      if (released != released_before || lone_cells != lone_before)
+        matrix_current = false;
     }
 
 

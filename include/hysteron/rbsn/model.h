@@ -144,6 +144,11 @@ namespace hysteron
       save(CheckpointWriter &out) const;
       void
       load(CheckpointReader &in);
+      /// The values of the system matrix (this rank's rows), in the pattern's order.
+      std::vector<double>
+      matrix_values() const;
+      void
+      set_matrix_values(const std::vector<double> &values);
 
       /// The run's summary, with the driver's counts.
       std::string
@@ -213,8 +218,20 @@ namespace hysteron
       // Steps.
       void
       make_constraints(const double t0, const double t1, const bool predictor);
+      /// The residual (and with @p matrix the tangent) at u_trial, time t1, step dt. The
+      /// tangent is built from scratch, or (matrix_current) updated by the facets whose
+      /// tangent changed since it was assembled.
       bool
       assemble(const double t1, const double dt, const bool matrix, const bool update_springs);
+      /// The right-hand side of a local matrix and vector as
+      /// distribute_local_to_global(K, r, dofs, matrix, rhs, true) makes it, without the matrix.
+      void
+      add_local_rhs(const dealii::FullMatrix<double>                     &K,
+                    const dealii::Vector<double>                         &r,
+                    const std::vector<dealii::types::global_dof_index> &dofs);
+      /// Add the local matrix @p K to the free rows and columns of the system matrix.
+      void
+      add_local_change(dealii::FullMatrix<double> &K, const std::vector<dealii::types::global_dof_index> &dofs);
       bool
       solve_step(const double t, const double dt);
       /// One attempt of solve_step(): predictor and Newton iterations.
@@ -370,6 +387,7 @@ namespace hysteron
       VariableOrderParameters       variable_order;
       bool                          spring_table = false;
       double                        reuse_tolerance = 0; ///< `Tangent reuse tolerance`
+      bool                          incremental_assembly = true; ///< `Incremental assembly`
       std::string                   distributed_solver;  ///< `Distributed direct solver`
       std::string                   linear_solver;       ///< `Linear solver`: direct, cg, gmres
       double                        solver_tolerance = 1e-10;
@@ -411,6 +429,19 @@ namespace hysteron
       unsigned long                     n_factorizations  = 0;
       unsigned long                     n_exact_retries   = 0; ///< steps modified Newton failed
       dealii::AffineConstraints<double> constraints;
+      /// Incremental assembly: the tangent D of every facet in the assembled matrix (broken:
+      /// none), and whether the matrix is that sum with the current constrained DoFs and
+      /// step (else the next assembly starts from zero), as does the assembly after
+      /// max_incremental_updates updates. A checkpoint holds this state and the matrix, so
+      /// that a resumed run takes the same steps bit for bit.
+      std::vector<SpringLaw::Matrix> assembled_tangent;
+      std::vector<bool>              facet_in_matrix;
+      bool                           matrix_current = false;
+      double                         matrix_dt      = 0;
+      unsigned int                   incremental_updates = 0;
+      static constexpr unsigned int  max_incremental_updates = 100;
+      unsigned long                  n_matrix_assemblies = 0, n_full_assemblies = 0;
+      unsigned long                  n_facet_evaluations = 0, n_facet_updates = 0;
       /// f_int, f_ext and inertia: the last evaluation (an iterate); f_ext_old and
       /// reaction_old (f_int + inertia - f_ext): the converged state, which the output reads.
       Vector u, u_trial, v, a, rhs, f_int, f_ext, f_ext_old, inertia, reaction_old;
