@@ -1,10 +1,12 @@
 #include <deal.II/base/exceptions.h>
+#include <deal.II/base/timer.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/vector.h>
 
 #include <hysteron/fem/fem.h>
 
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -44,6 +46,7 @@ namespace hysteron
     {
       using namespace dealii;
       const Scene<dim> &scene   = this->get_scene();
+      TimerOutput::Scope timing(scene.timer(), "FEM assembly");
       const bool        matrix  = what == Assemble::residual_and_matrix;
       // dt = 0: the forces of the state u_iterate only (the initial state).
       const bool        dynamic = analysis == Analysis::implicit_dynamics && dt > 0;
@@ -88,6 +91,10 @@ namespace hysteron
       const Tensor<1, dim> &g = scene.gravity();
       const unsigned int    n_loads = load_sets.size();
 
+      // 2D: the thickness at a point of the body of the cell (weights hold it already).
+      const auto thickness = [&](const CellHistory<dim> &h, const Point<dim> &x) {
+        return scene.body_descriptions()[h.body].thickness_at(x);
+      };
       // f += sum_q N_i (rho g + volume loads) w_q + tractions on the boundary faces
       // whose centre lies in the load's region (load values already scaled).
       const auto external = [&](const auto                        &cell,
@@ -114,7 +121,7 @@ namespace hysteron
                   ffv.reinit(cell, face);
                   for (unsigned int q = 0; q < ffv.n_quadrature_points; ++q)
                     for (unsigned int i = 0; i < n; ++i)
-                      f[i] += ffv.shape_value(i, q) * value[l][comp[i]] * ffv.JxW(q) * h.thickness;
+                      f[i] += ffv.shape_value(i, q) * value[l][comp[i]] * ffv.JxW(q) * thickness(h, ffv.quadrature_point(q));
                 }
       };
 
@@ -143,6 +150,7 @@ namespace hysteron
             // The material: from the converged state to the trial state.
             h.trial_stress = h.stress;
             h.trial_state  = h.state;
+            const auto material_start = std::chrono::steady_clock::now();
             if (update_material && !failed)
               try
                 {
@@ -160,6 +168,7 @@ namespace hysteron
                     << scene.body_descriptions()[h.body].name << "', step to t = " << t1 << " s)";
                   message = m.str();
                 }
+            material_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - material_start).count();
             if (failed)
               continue;
 

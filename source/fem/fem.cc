@@ -388,6 +388,10 @@ namespace hysteron
       if (analysis != Analysis::explicit_dynamics)
         s << ", " << n_newton << " Newton iterations, " << n_cuts << " increment cuts";
       s << ", " << dof_handler.n_dofs() << " DoFs, " << this->n_outputs() << " outputs";
+      // The material's share of the timer's "FEM assembly" (this rank's).
+      std::ostringstream seconds;
+      seconds << std::setprecision(3) << material_seconds;
+      s << ", material updates " << seconds.str() << " s of the assembly";
       return s.str();
     }
 

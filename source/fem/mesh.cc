@@ -269,7 +269,6 @@ namespace hysteron
             const unsigned int m = cell->material_id();
             h.material  = body_material[m];
             h.body      = mesh_to_body[m];
-            h.thickness = dim == 2 ? bodies[h.body].thickness : 1.0;
             h.n_state   = h.material->n_state_variables();
             h.stress.assign(n_q, dealii::SymmetricTensor<2, dim>());
             h.strain        = h.stress;
@@ -285,8 +284,8 @@ namespace hysteron
             fv.reinit(cell);
             for (unsigned int q = 0; q < n_q; ++q)
               {
-                h.weight[q] = fv.JxW(q) * h.thickness;
                 h.point[q]  = fv.quadrature_point(q);
+                h.weight[q] = fv.JxW(q) * bodies[h.body].thickness_at(h.point[q]);
               }
             // Until a first evaluation: the elastic tangent (the first predictor).
             h.tangent.assign(n_q, h.material->elasticity().template stiffness<dim>());

@@ -1,4 +1,5 @@
 // The FEM's linear solvers and the implicit (quasi-static, Newmark/HHT) step with Newton.
+#include <deal.II/base/timer.h>
 #include <deal.II/base/utilities.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_q.h>
@@ -32,6 +33,7 @@ namespace hysteron
     Solver<dim>::solve_linear(Vector &du)
     {
       using namespace dealii;
+      TimerOutput::Scope timing(this->get_scene().timer(), "FEM linear solve");
       const double rhs_norm = system_rhs.l2_norm();
       if (solver_type == LinearSolver::direct)
         {

@@ -308,6 +308,7 @@ namespace hysteron
       unsigned int                                  current_group_key = 0;
       unsigned int                                  n_properties      = 0;
       std::vector<unsigned long>                    load_count; ///< points per load (index 0: none)
+      std::vector<double>                           load_volume; ///< their volume (a force's share)
       dealii::types::particle_index                 n_global_particles = 0;
     };
 

@@ -126,6 +126,7 @@ namespace hysteron
       // counts and probe points agree) and keeps those in its own cells.
       const Lattice<dim> &lattice = grid->lattice();
       load_count.assign(loads.size() + 1, 0);
+      load_volume.assign(loads.size() + 1, 0.0);
       std::vector<double>    properties(n_properties);
       types::particle_index  next_id = 0;
       std::vector<double>    best_distance(probes.size(), std::numeric_limits<double>::max());
@@ -140,8 +141,8 @@ namespace hysteron
                     " sub-cells of each grid cell: refine the grid or raise `Particles per "
                     "cell`)");
           const auto  &group     = group_templates[group_of_body[b]];
-          const double thickness = dim == 2 ? body.thickness : 1.0;
-          const double volume    = std::pow(lattice.h / body.particles_per_cell, dim) * thickness;
+          // The point's share of the body: its sub-cell times the thickness there (2D).
+          const double cell_volume = std::pow(lattice.h / body.particles_per_cell, dim);
           const double density =
             scene.material(body.material, "Body " + body.name + "/Material").density();
           for (const auto &x : points)
@@ -152,7 +153,11 @@ namespace hysteron
                 for (unsigned int l = 0; l < loads.size() && load == 0; ++l)
                   if (loads[l].region.contains(x, 1e-9 * lattice.h))
                     load = l + 1;
+              // On every rank (the same error everywhere if it is not > 0).
+              const double thickness = body.thickness_at(x);
+              const double volume    = cell_volume * thickness;
               ++load_count[load];
+              load_volume[load] += volume;
               for (unsigned int i = 0; i < probes.size(); ++i)
                 if (!body.rigid)
                   {
@@ -326,13 +331,13 @@ namespace hysteron
                     q.begin() + PI::n_fixed + group.n_state,
                     P.current.material_state.begin() + group.state_offset +
                       std::size_t(s - group.begin) * group.n_state);
-          // Load share: a total force is split evenly; a traction acts on the
-          // point's face, of area V / l_p with l_p = (V / thickness)^(1/dim).
+          // Load share: a total force is split by volume (evenly for a constant thickness);
+          // a traction acts on the point's face, of area V / l_p with l_p = (V / thickness)^(1/dim).
           P.load_factor[s] = 0;
           if (P.load[s] > 0)
             {
               if (loads[P.load[s] - 1].type == LoadDescription<dim>::Type::force)
-                P.load_factor[s] = 1.0 / load_count[P.load[s]];
+                P.load_factor[s] = P.volume0[s] / load_volume[P.load[s]];
               else
                 P.load_factor[s] = P.volume0[s] / std::pow(P.volume0[s] / P.thickness[s], 1.0 / dim);
             }

@@ -389,11 +389,13 @@ namespace hysteron
               }
           const auto  &body = bodies[cell_body[c]];
           const double rho  = scene.material(body.material, "Body " + body.name + "/Material").density();
-          const double m    = rho * body.thickness * cell.area;
+          // A varying thickness is taken at the cell's centroid (midpoint rule over the cell).
+          const double t    = body.thickness_at(cell.centroid);
+          const double m    = rho * t * cell.area;
           cell_mass[c]      = m;
           cell_offset[c]    = cell.centroid - cell.nucleus;
           // I_c + m r^2: the polar moment about the nucleus.
-          cell_inertia[c] = rho * body.thickness * cell.polar_moment + m * cell_offset[c].norm_square();
+          cell_inertia[c] = rho * t * cell.polar_moment + m * cell_offset[c].norm_square();
         }
     }
 
@@ -411,7 +413,8 @@ namespace hysteron
           const auto  &ba = bodies[cell_body[f.a]], &bb = bodies[cell_body[f.b]];
           const auto  &ma = scene.material(ba.material, "Body " + ba.name + "/Material");
           const auto  &mb = scene.material(bb.material, "Body " + bb.name + "/Material");
-          const double t  = std::min(ba.thickness, bb.thickness);
+          // The thinner side at the facet's midpoint (two bodies may meet there).
+          const double t  = std::min(ba.thickness_at(f.midpoint), bb.thickness_at(f.midpoint));
           const double l  = f.length;
           // Voronoi scaling (eq. 3.9), the two half-cells in series:
           // k_n = t l / (h_a / E'_a + h_b / E'_b), k_t likewise with G, k_phi = k_n l^2 / 12.
@@ -583,7 +586,7 @@ namespace hysteron
                     continue;
                   set.cells.push_back(c);
                   set.arm.push_back(mid - network.cells[c].nucleus);
-                  set.weight.push_back(piece[0].distance(piece[1]) * bodies[cell_body[c]].thickness);
+                  set.weight.push_back(piece[0].distance(piece[1]) * bodies[cell_body[c]].thickness_at(mid));
                 }
           require(!set.cells.empty(),
                   "Load " + loads[l].name + "/Region",

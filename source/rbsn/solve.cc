@@ -62,7 +62,7 @@ namespace hysteron
       inertia = 0;
       external_forces(t1, f_ext);
 
-      dealii::FullMatrix<double>                K(6, 6), K_old(6, 6), K0(6, 6);
+      dealii::FullMatrix<double>                K(6, 6), K0(6, 6);
       dealii::Vector<double>                    r(6), fe(6), fe0(6), ue(6), ve0(6), ve1(6), tmp(6);
       std::vector<dealii::types::global_dof_index> dofs(6);
       bool        failed = false;
@@ -78,10 +78,10 @@ namespace hysteron
                 M(p, q) += sp.B(i, p) * sp.k[i] * sp.B(i, q);
             }
       };
-      // The facet's matrix for the tangent D: B^T D B (the diagonal of D only, for linear
+      // The springs' matrix for the tangent D: B^T D B (the diagonal of D only, for linear
       // springs and laws of independent springs; else the full, not necessarily symmetric
-      // D); in dynamics (1 + alpha) B^T D B + (1 + alpha) gamma / (beta dt) a1 K0.
-      const auto facet_matrix = [&](const Springs &sp, const SpringLaw::Matrix &D, dealii::FullMatrix<double> &M) {
+      // D), in dynamics times 1 + alpha. Linear in D.
+      const auto spring_matrix = [&](const Springs &sp, const SpringLaw::Matrix &D, dealii::FullMatrix<double> &M) {
         const bool diagonal = diagonal_law || !sp.hysteretic;
         for (unsigned int p = 0; p < 6; ++p)
           for (unsigned int q = 0; q < 6; ++q)
@@ -95,8 +95,14 @@ namespace hysteron
                     M(p, q) += sp.B(i, p) * D[i][j] * sp.B(j, q);
             }
         if (dynamic)
+          M *= 1 + alpha;
+      };
+      // The facet's matrix: the springs' and, in dynamics, the damping (1 + alpha) gamma /
+      // (beta dt) a1 K0.
+      const auto facet_matrix = [&](const Springs &sp, const SpringLaw::Matrix &D, dealii::FullMatrix<double> &M) {
+        spring_matrix(sp, D, M);
+        if (dynamic)
           {
-            M *= 1 + alpha;
             if (dynamics.rayleigh_stiffness > 0)
               {
                 elastic_matrix(sp, K0);
@@ -218,24 +224,23 @@ namespace hysteron
             }
           else
             {
-              // Only a facet whose tangent changed adds to the matrix: the difference of
-              // its new and assembled parts. Its matrix is needed for the right-hand side
+              // Only a facet whose tangent changed adds to the matrix: B^T (D - D_old) B
+              // (the damping part stays). Its full matrix is needed for the right-hand side
               // where it meets prescribed DoFs.
-              const bool changed     = !facet_in_matrix[e] || sp.tangent != assembled_tangent[e];
-              const bool constrained = any_constrained(dofs);
-              if (changed || constrained)
-                facet_matrix(sp, sp.tangent, K);
-              if (constrained)
-                add_local_rhs(K, r, dofs);
+              const bool changed = !facet_in_matrix[e] || sp.tangent != assembled_tangent[e];
+              if (any_constrained(dofs))
+                {
+                  facet_matrix(sp, sp.tangent, K);
+                  add_local_rhs(K, r, dofs);
+                }
               else
                 add_local(K, r, dofs, false);
               if (!changed)
                 continue;
               if (facet_in_matrix[e])
-                {
-                  facet_matrix(sp, assembled_tangent[e], K_old);
-                  K.add(-1.0, K_old);
-                }
+                spring_matrix(sp, sp.tangent - assembled_tangent[e], K);
+              else
+                facet_matrix(sp, sp.tangent, K);
               add_local_change(K, dofs);
             }
           assembled_tangent[e] = sp.tangent;

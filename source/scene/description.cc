@@ -4,6 +4,8 @@
 #include <hysteron/scene/description.h>
 
 #include <cmath>
+#include <limits>
+#include <sstream>
 
 namespace hysteron
 {
@@ -63,6 +65,26 @@ namespace hysteron
       for (unsigned int d = 0; d < dim; ++d)
         v[d] = initial_velocity->value(p, d);
     return v;
+  }
+
+  template <int dim>
+  double
+  BodyDescription<dim>::thickness_at(const dealii::Point<dim> &p) const
+  {
+    if (dim != 2)
+      return 1.0;
+    if (!thickness_function)
+      return thickness;
+    const double t = thickness_function->value(p);
+    if (!(t > 0) || !std::isfinite(t))
+      {
+        std::ostringstream s;
+        s.precision(6);
+        s << "the expression '" << thickness_expression << "' evaluates to " << t << " at x = " << p[0]
+          << ", y = " << p[1] << " in body '" << name << "': the thickness must be > 0 wherever the body has material";
+        throw InputError(thickness_where, s.str());
+      }
+    return t;
   }
 
   template <int dim>
@@ -183,9 +205,14 @@ namespace hysteron
                           "MPM: material points per grid cell and direction (k^dim per cell).");
         prm.declare_entry("Thickness",
                           "1",
-                          Patterns::Double(),
+                          Patterns::Anything(),
                           "2D: out-of-plane thickness [m], > 0 (plane strain: the length along "
-                          "z that the results refer to). Ignored in 3D.");
+                          "z that the results refer to): a number, or a function of x, y, e.g. "
+                          "the flanges and web of an I-section, 'abs(y) > 0.15 ? 0.3 : 0.015' "
+                          "(doc/geometry.md). It weights the mass, volume, internal forces and "
+                          "loads of the MPM's points (at each point), the FEM's quadrature points "
+                          "and the RBSN's cells and facets; it must be > 0 wherever it is "
+                          "evaluated. Ignored in 3D.");
         prm.declare_entry("Initial velocity",
                           "",
                           Patterns::Anything(),
@@ -282,7 +309,21 @@ namespace hysteron
                 "a body needs a shape, e.g. 'rectangle(0, 0, 1, 1)'");
         b.shape              = Geometry::Region<dim>::parse(s.get("Shape"), s.where("Shape"));
         b.particles_per_cell = s.get_integer("Particles per cell");
-        b.thickness          = s.get_positive("Thickness");
+        // A number is a constant thickness; anything else an expression in x, y.
+        const std::string thickness = dealii::Utilities::trim(s.get("Thickness"));
+        char             *end       = nullptr;
+        std::strtod(thickness.c_str(), &end);
+        if (!thickness.empty() && end == thickness.c_str() + thickness.size())
+          b.thickness = s.get_positive("Thickness");
+        else
+          {
+            require(!thickness.empty(), s.where("Thickness"), "the thickness is empty: give a number or a function of x, y");
+            b.thickness_function =
+              parse_function<dim>(thickness, space_variables<dim>(), false, s.where("Thickness"));
+            b.thickness_expression = thickness;
+            b.thickness_where      = s.where("Thickness");
+            b.thickness            = std::numeric_limits<double>::quiet_NaN(); // read thickness_at()
+          }
         if (!dealii::Utilities::trim(s.get("Initial velocity")).empty())
           b.initial_velocity = parse_vector_function<dim>(s.get("Initial velocity"),
                                                           dim,

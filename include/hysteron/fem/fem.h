@@ -69,13 +69,12 @@ namespace hysteron
       const Material::Interface<dim>              *material  = nullptr;
       unsigned int                                 body      = 0;
       unsigned int                                 n_state   = 0;
-      double                                       thickness = 1; ///< 2D: out-of-plane [m]
       std::vector<dealii::SymmetricTensor<2, dim>> stress, strain;  ///< converged
       std::vector<double>                          state;           ///< converged, n_q x n_state
       std::vector<dealii::SymmetricTensor<2, dim>> trial_stress, increment;
       std::vector<double>                          trial_state;
       std::vector<dealii::SymmetricTensor<4, dim>> tangent;
-      std::vector<double>                          weight; ///< JxW times the thickness
+      std::vector<double>                          weight; ///< JxW times the thickness t(x_q)
       std::vector<dealii::Point<dim>>              point;  ///< quadrature points (reference configuration)
     };
 
@@ -406,6 +405,9 @@ namespace hysteron
       /// Work of this rank's cells and DoFs since t = 0 (summed when a row is written).
       double internal_work = 0, external_work = 0, boundary_work = 0;
       unsigned long n_newton = 0, n_cuts = 0, n_linear = 0;
+      /// Wall time of the material updates inside assemble() (the timer table has the
+      /// sections "FEM assembly", which includes them, and "FEM linear solve").
+      double material_seconds = 0;
       /// The load increments (their cuts and recovery); the nominal step is set at set-up.
       IncrementControl increments{1.0, 0};
       /// The nominal step was checked against the critical step of explicit dynamics.

@@ -45,13 +45,29 @@ namespace hysteron
     std::string                                   material; ///< "" is the default material
     Geometry::Region<dim>                         shape;
     unsigned int                                  particles_per_cell = 2;
+    /// 2D: the out-of-plane thickness, a constant, or (thickness_function) a function of
+    /// x, y read through thickness_at(); 3D: 1.
     double                                        thickness          = 1.0;
+    std::shared_ptr<dealii::FunctionParser<dim>>  thickness_function; ///< null: constant
+    std::string                                   thickness_expression, thickness_where;
     std::shared_ptr<dealii::FunctionParser<dim>>  initial_velocity; ///< of x; null: at rest
     bool                                          rigid = false;
     std::shared_ptr<dealii::FunctionParser<1>>    rigid_velocity; ///< of t (rigid bodies)
 
     dealii::Tensor<1, dim>
     velocity_at(const dealii::Point<dim> &p) const;
+
+    /// The thickness at @p p [m] (1 in 3D); an InputError naming the expression and the
+    /// point unless it is > 0 and finite there.
+    double
+    thickness_at(const dealii::Point<dim> &p) const;
+
+    /// Whether the thickness varies (an expression, 2D).
+    bool
+    varying_thickness() const
+    {
+      return dim == 2 && thickness_function != nullptr;
+    }
   };
 
   /**
