@@ -74,7 +74,8 @@ namespace hysteron
         Mv(n), Cv0(n), Cv1(n), tmp(n);
       std::vector<types::global_dof_index>          dofs(n);
       std::vector<std::vector<SymmetricTensor<2, dim>>> B(n_q, std::vector<SymmetricTensor<2, dim>>(n));
-      std::vector<SymmetricTensor<2, dim>>          CB(n);
+      std::vector<Tensor<1, dim>>                   G(n); // the shape gradients at one point
+      std::vector<double>                           C(dim * dim * dim * dim), H(n * dim * dim);
       std::vector<unsigned int>                     comp(n);
       for (unsigned int i = 0; i < n; ++i)
         comp[i] = fe->system_to_component_index(i).first;
@@ -172,6 +173,11 @@ namespace hysteron
             if (failed)
               continue;
 
+            // Shape function i moves component c_i only, with the gradient g_i of its scalar
+            // shape function: B_i = sym(e_{c_i} (x) g_i), so (with the minor symmetries of
+            // sigma and C) B_i : sigma = sigma_{c_i b} g_i[b] and
+            //   B_i : C : B_j = g_i[b] C_{c_i b c_j d} g_j[d],
+            // dim^2 products per pair instead of a contraction of two symmetric tensors.
             fi = 0;
             if (matrix)
               A = 0;
@@ -179,14 +185,43 @@ namespace hysteron
               {
                 const double w = h.weight[q];
                 for (unsigned int i = 0; i < n; ++i)
-                  fi[i] += (B[q][i] * h.trial_stress[q]) * w;
+                  G[i] = fv.shape_grad(i, q);
+                const SymmetricTensor<2, dim> &s = h.trial_stress[q];
+                for (unsigned int i = 0; i < n; ++i)
+                  {
+                    double v = 0;
+                    for (unsigned int b = 0; b < dim; ++b)
+                      v += s[comp[i]][b] * G[i][b];
+                    fi[i] += v * w;
+                  }
                 if (matrix)
                   {
+                    // C as a plain array, then H_j[c][b] = w C_{c b c_j d} g_j[d].
+                    const SymmetricTensor<4, dim> &T = h.tangent[q];
+                    for (unsigned int a = 0; a < dim; ++a)
+                      for (unsigned int b = 0; b < dim; ++b)
+                        for (unsigned int c = 0; c < dim; ++c)
+                          for (unsigned int d = 0; d < dim; ++d)
+                            C[((a * dim + b) * dim + c) * dim + d] = T[a][b][c][d];
                     for (unsigned int j = 0; j < n; ++j)
-                      CB[j] = h.tangent[q] * B[q][j];
+                      for (unsigned int c = 0; c < dim; ++c)
+                        for (unsigned int b = 0; b < dim; ++b)
+                          {
+                            const double *row = &C[((c * dim + b) * dim + comp[j]) * dim];
+                            double        v   = 0;
+                            for (unsigned int d = 0; d < dim; ++d)
+                              v += row[d] * G[j][d];
+                            H[(j * dim + c) * dim + b] = w * v;
+                          }
                     for (unsigned int i = 0; i < n; ++i)
                       for (unsigned int j = 0; j < n; ++j)
-                        A(i, j) += (B[q][i] * CB[j]) * w;
+                        {
+                          const double *hj = &H[(j * dim + comp[i]) * dim];
+                          double        v  = 0;
+                          for (unsigned int b = 0; b < dim; ++b)
+                            v += G[i][b] * hj[b];
+                          A(i, j) += v;
+                        }
                   }
               }
             external(cell, h, load1, fx);
