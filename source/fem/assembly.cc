@@ -1,5 +1,8 @@
 #include <deal.II/base/exceptions.h>
+#include <deal.II/base/multithread_info.h>
 #include <deal.II/base/timer.h>
+#include <deal.II/base/work_stream.h>
+#include <deal.II/grid/filtered_iterator.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/vector.h>
@@ -64,19 +67,8 @@ namespace hysteron
 
       const unsigned int n   = fe->n_dofs_per_cell();
       const unsigned int n_q = quadrature->size();
-      FEValues<dim>      fv(mapping, *fe, *quadrature, update_values | update_gradients);
-      FEFaceValues<dim>  ffv(mapping, *fe, *face_quadrature,
-                            update_values | update_quadrature_points | update_JxW_values);
       const FEValuesExtractors::Vector displacement(0);
-
-      FullMatrix<double>   A(n, n), M(n, n), K0(n, n);
-      dealii::Vector<double> r(n), fi(n), fx(n), fx0(n), fi0(n), du(n), v0(n), a0(n), a1(n), v1(n),
-        Mv(n), Cv0(n), Cv1(n), tmp(n);
-      std::vector<types::global_dof_index>          dofs(n);
-      std::vector<std::vector<SymmetricTensor<2, dim>>> B(n_q, std::vector<SymmetricTensor<2, dim>>(n));
-      std::vector<Tensor<1, dim>>                   G(n); // the shape gradients at one point
-      std::vector<double>                           C(dim * dim * dim * dim), H(n * dim * dim);
-      std::vector<unsigned int>                     comp(n);
+      std::vector<unsigned int>        comp(n);
       for (unsigned int i = 0; i < n; ++i)
         comp[i] = fe->system_to_component_index(i).first;
 
@@ -101,7 +93,9 @@ namespace hysteron
       const auto external = [&](const auto                        &cell,
                                 const CellHistory<dim>            &h,
                                 const std::vector<Tensor<1, dim>> &value,
-                                dealii::Vector<double>            &f) {
+                                dealii::Vector<double>            &f,
+                                const FEValues<dim>               &fv,
+                                FEFaceValues<dim>                 &ffv) {
         f                                 = 0;
         const std::size_t first = cell->active_cell_index() * n_loads;
         for (unsigned int q = 0; q < n_q; ++q)
@@ -126,182 +120,277 @@ namespace hysteron
                 }
       };
 
-      bool        failed = false;
-      std::string message;
-      for (const auto &cell : dof_handler.active_cell_iterators())
-        if (cell->is_locally_owned())
+      // Cell by cell, in parallel threads (`FEM/Threads`): the worker forms a cell's
+      // matrix and vectors (and updates its material points, which only it touches); the
+      // copier adds them to the global system in the order of the cells, so that the
+      // sums, and the first failure reported, do not depend on the number of threads.
+      struct Scratch
+      {
+        Scratch(const Mapping<dim> &mapping, const FiniteElement<dim> &fe, const Quadrature<dim> &quadrature,
+                const Quadrature<dim - 1> &face_quadrature)
+          : fv(mapping, fe, quadrature, update_values | update_gradients)
+          , ffv(mapping, fe, face_quadrature, update_values | update_quadrature_points | update_JxW_values)
+          , M(fe.n_dofs_per_cell(), fe.n_dofs_per_cell())
+          , K0(M)
+          , B(quadrature.size(), std::vector<SymmetricTensor<2, dim>>(fe.n_dofs_per_cell()))
+          , G(fe.n_dofs_per_cell())
+          , C(dim * dim * dim * dim)
+          , H(fe.n_dofs_per_cell() * dim * dim)
+        {
+          for (auto *x : {&fx0, &fi0, &du, &v0, &a0, &a1, &v1, &Cv0, &Cv1, &tmp})
+            x->reinit(fe.n_dofs_per_cell());
+        }
+        Scratch(const Scratch &other)
+          : Scratch(other.fv.get_mapping(), other.fv.get_fe(), other.fv.get_quadrature(), other.ffv.get_quadrature())
+        {}
+        FEValues<dim>                                   fv;
+        FEFaceValues<dim>                               ffv;
+        FullMatrix<double>                              M, K0;
+        dealii::Vector<double>                          fx0, fi0, du, v0, a0, a1, v1, Cv0, Cv1, tmp;
+        std::vector<std::vector<SymmetricTensor<2, dim>>> B;
+        std::vector<Tensor<1, dim>>                     G; // the shape gradients at one point
+        std::vector<double>                             C, H;
+      };
+      struct Copy
+      {
+        explicit Copy(const unsigned int n)
+          : A(n, n)
+          , r(n)
+          , fi(n)
+          , fx(n)
+          , Mv(n)
+          , dofs(n)
+        {}
+        FullMatrix<double>                   A;
+        dealii::Vector<double>               r, fi, fx, Mv; ///< Mv: the inertia forces (dynamics)
+        std::vector<types::global_dof_index> dofs;
+        bool                                 active = false, failed = false;
+        std::string                          message;
+        double                               material_seconds = 0;
+      };
+      using CellIterator = typename DoFHandler<dim>::active_cell_iterator;
+      const auto worker = [&](const CellIterator &cell, Scratch &scratch, Copy &out) {
+        out.active = out.failed = false;
+        auto &fv = scratch.fv;
+        auto &ffv = scratch.ffv;
+        auto &M = scratch.M, &K0 = scratch.K0;
+        auto &fx0 = scratch.fx0, &fi0 = scratch.fi0, &du = scratch.du, &v0 = scratch.v0, &a0 = scratch.a0,
+             &a1 = scratch.a1, &v1 = scratch.v1, &Cv0 = scratch.Cv0, &Cv1 = scratch.Cv1, &tmp = scratch.tmp;
+        auto &B = scratch.B;
+        auto &G = scratch.G;
+        auto &C = scratch.C, &H = scratch.H;
+        auto &A = out.A;
+        auto &r = out.r, &fi = out.fi, &fx = out.fx, &Mv = out.Mv;
+        auto &dofs = out.dofs;
+        Mv = 0;
+        fv.reinit(cell);
+        cell->get_dof_indices(dofs);
+        out.active = true;
+        CellHistory<dim> &h   = *cell_history[cell->active_cell_index()];
+        const double      rho = h.material->density();
+        for (unsigned int i = 0; i < n; ++i)
+          du[i] = u_iterate(dofs[i]) - u_ghost(dofs[i]);
+        for (unsigned int q = 0; q < n_q; ++q)
           {
-            fv.reinit(cell);
-            cell->get_dof_indices(dofs);
-            CellHistory<dim> &h   = *cell_history[cell->active_cell_index()];
-            const double      rho = h.material->density();
             for (unsigned int i = 0; i < n; ++i)
-              du[i] = u_iterate(dofs[i]) - u_ghost(dofs[i]);
-            for (unsigned int q = 0; q < n_q; ++q)
+              B[q][i] = fv[displacement].symmetric_gradient(i, q);
+            SymmetricTensor<2, dim> e;
+            for (unsigned int i = 0; i < n; ++i)
+              if (du[i] != 0)
+                e += du[i] * B[q][i];
+            h.increment[q] = e;
+          }
+
+        // The material: from the converged state to the trial state.
+        h.trial_stress = h.stress;
+        h.trial_state  = h.state;
+        const auto material_start = std::chrono::steady_clock::now();
+        if (update_material)
+          try
+            {
+              h.material->update(make_array_view(std::as_const(h.increment)),
+                                 make_array_view(h.trial_stress),
+                                 make_array_view(h.trial_state),
+                                 matrix ? make_array_view(h.tangent) :
+                                          ArrayView<SymmetricTensor<4, dim>>());
+            }
+          catch (const RuntimeError &e)
+            {
+              out.failed = true;
+              std::ostringstream m;
+              m << e.what() << " (in the cell at " << cell->center() << ", body '"
+                << scene.body_descriptions()[h.body].name << "', step to t = " << t1 << " s)";
+              out.message = m.str();
+            }
+        out.material_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - material_start).count();
+        if (out.failed)
+          return;
+
+        // Shape function i moves component c_i only, with the gradient g_i of its scalar
+        // shape function: B_i = sym(e_{c_i} (x) g_i), so (with the minor symmetries of
+        // sigma and C) B_i : sigma = sigma_{c_i b} g_i[b] and
+        //   B_i : C : B_j = g_i[b] C_{c_i b c_j d} g_j[d],
+        // dim^2 products per pair instead of a contraction of two symmetric tensors.
+        fi = 0;
+        if (matrix)
+          A = 0;
+        for (unsigned int q = 0; q < n_q; ++q)
+          {
+            const double w = h.weight[q];
+            for (unsigned int i = 0; i < n; ++i)
+              G[i] = fv.shape_grad(i, q);
+            const SymmetricTensor<2, dim> &s = h.trial_stress[q];
+            for (unsigned int i = 0; i < n; ++i)
               {
-                for (unsigned int i = 0; i < n; ++i)
-                  B[q][i] = fv[displacement].symmetric_gradient(i, q);
-                SymmetricTensor<2, dim> e;
-                for (unsigned int i = 0; i < n; ++i)
-                  if (du[i] != 0)
-                    e += du[i] * B[q][i];
-                h.increment[q] = e;
+                double v = 0;
+                for (unsigned int b = 0; b < dim; ++b)
+                  v += s[comp[i]][b] * G[i][b];
+                fi[i] += v * w;
               }
-
-            // The material: from the converged state to the trial state.
-            h.trial_stress = h.stress;
-            h.trial_state  = h.state;
-            const auto material_start = std::chrono::steady_clock::now();
-            if (update_material && !failed)
-              try
-                {
-                  h.material->update(make_array_view(std::as_const(h.increment)),
-                                     make_array_view(h.trial_stress),
-                                     make_array_view(h.trial_state),
-                                     matrix ? make_array_view(h.tangent) :
-                                              ArrayView<SymmetricTensor<4, dim>>());
-                }
-              catch (const RuntimeError &e)
-                {
-                  failed = true;
-                  std::ostringstream m;
-                  m << e.what() << " (in the cell at " << cell->center() << ", body '"
-                    << scene.body_descriptions()[h.body].name << "', step to t = " << t1 << " s)";
-                  message = m.str();
-                }
-            material_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - material_start).count();
-            if (failed)
-              continue;
-
-            // Shape function i moves component c_i only, with the gradient g_i of its scalar
-            // shape function: B_i = sym(e_{c_i} (x) g_i), so (with the minor symmetries of
-            // sigma and C) B_i : sigma = sigma_{c_i b} g_i[b] and
-            //   B_i : C : B_j = g_i[b] C_{c_i b c_j d} g_j[d],
-            // dim^2 products per pair instead of a contraction of two symmetric tensors.
-            fi = 0;
             if (matrix)
-              A = 0;
+              {
+                // C as a plain array, then H_j[c][b] = w C_{c b c_j d} g_j[d].
+                const SymmetricTensor<4, dim> &T = h.tangent[q];
+                for (unsigned int a = 0; a < dim; ++a)
+                  for (unsigned int b = 0; b < dim; ++b)
+                    for (unsigned int c = 0; c < dim; ++c)
+                      for (unsigned int d = 0; d < dim; ++d)
+                        C[((a * dim + b) * dim + c) * dim + d] = T[a][b][c][d];
+                for (unsigned int j = 0; j < n; ++j)
+                  for (unsigned int c = 0; c < dim; ++c)
+                    for (unsigned int b = 0; b < dim; ++b)
+                      {
+                        const double *row = &C[((c * dim + b) * dim + comp[j]) * dim];
+                        double        v   = 0;
+                        for (unsigned int d = 0; d < dim; ++d)
+                          v += row[d] * G[j][d];
+                        H[(j * dim + c) * dim + b] = w * v;
+                      }
+                for (unsigned int i = 0; i < n; ++i)
+                  for (unsigned int j = 0; j < n; ++j)
+                    {
+                      const double *hj = &H[(j * dim + comp[i]) * dim];
+                      double        v  = 0;
+                      for (unsigned int b = 0; b < dim; ++b)
+                        v += G[i][b] * hj[b];
+                      A(i, j) += v;
+                    }
+              }
+          }
+        external(cell, h, load1, fx, fv, ffv);
+
+        if (dynamic)
+          {
+            // Mass, elastic stiffness (damping) and the Newmark kinematics of the cell.
+            M  = 0;
+            K0 = 0;
+            const SymmetricTensor<4, dim> D = h.material->elasticity().template stiffness<dim>();
             for (unsigned int q = 0; q < n_q; ++q)
               {
                 const double w = h.weight[q];
                 for (unsigned int i = 0; i < n; ++i)
-                  G[i] = fv.shape_grad(i, q);
-                const SymmetricTensor<2, dim> &s = h.trial_stress[q];
-                for (unsigned int i = 0; i < n; ++i)
-                  {
-                    double v = 0;
-                    for (unsigned int b = 0; b < dim; ++b)
-                      v += s[comp[i]][b] * G[i][b];
-                    fi[i] += v * w;
-                  }
-                if (matrix)
-                  {
-                    // C as a plain array, then H_j[c][b] = w C_{c b c_j d} g_j[d].
-                    const SymmetricTensor<4, dim> &T = h.tangent[q];
-                    for (unsigned int a = 0; a < dim; ++a)
-                      for (unsigned int b = 0; b < dim; ++b)
-                        for (unsigned int c = 0; c < dim; ++c)
-                          for (unsigned int d = 0; d < dim; ++d)
-                            C[((a * dim + b) * dim + c) * dim + d] = T[a][b][c][d];
-                    for (unsigned int j = 0; j < n; ++j)
-                      for (unsigned int c = 0; c < dim; ++c)
-                        for (unsigned int b = 0; b < dim; ++b)
-                          {
-                            const double *row = &C[((c * dim + b) * dim + comp[j]) * dim];
-                            double        v   = 0;
-                            for (unsigned int d = 0; d < dim; ++d)
-                              v += row[d] * G[j][d];
-                            H[(j * dim + c) * dim + b] = w * v;
-                          }
-                    for (unsigned int i = 0; i < n; ++i)
-                      for (unsigned int j = 0; j < n; ++j)
-                        {
-                          const double *hj = &H[(j * dim + comp[i]) * dim];
-                          double        v  = 0;
-                          for (unsigned int b = 0; b < dim; ++b)
-                            v += G[i][b] * hj[b];
-                          A(i, j) += v;
-                        }
-                  }
-              }
-            external(cell, h, load1, fx);
-
-            if (dynamic)
-              {
-                // Mass, elastic stiffness (damping) and the Newmark kinematics of the cell.
-                M  = 0;
-                K0 = 0;
-                const SymmetricTensor<4, dim> D = h.material->elasticity().template stiffness<dim>();
-                for (unsigned int q = 0; q < n_q; ++q)
-                  {
-                    const double w = h.weight[q];
-                    for (unsigned int i = 0; i < n; ++i)
-                      for (unsigned int j = 0; j < n; ++j)
-                        if (comp[i] == comp[j])
-                          M(i, j) += rho * fv.shape_value(i, q) * fv.shape_value(j, q) * w;
-                    if (dynamics.rayleigh_stiffness > 0)
-                      for (unsigned int j = 0; j < n; ++j)
-                        {
-                          const SymmetricTensor<2, dim> DB = D * B[q][j];
-                          for (unsigned int i = 0; i < n; ++i)
-                            K0(i, j) += (B[q][i] * DB) * w;
-                        }
-                  }
-                fi0 = 0;
-                for (unsigned int q = 0; q < n_q; ++q)
-                  for (unsigned int i = 0; i < n; ++i)
-                    fi0[i] += (B[q][i] * h.stress[q]) * h.weight[q];
-                external(cell, h, load0, fx0);
-                for (unsigned int i = 0; i < n; ++i)
-                  {
-                    v0[i] = v_ghost(dofs[i]);
-                    a0[i] = a_ghost(dofs[i]);
-                    a1[i] = (du[i] - dt * v0[i]) / (beta * dt * dt) - (1 - 2 * beta) / (2 * beta) * a0[i];
-                    v1[i] = v0[i] + dt * ((1 - gamma) * a0[i] + gamma * a1[i]);
-                  }
-                // C v = a0 M v + a1 K0 v.
-                M.vmult(Mv, a1);
-                M.vmult(Cv0, v0);
-                M.vmult(Cv1, v1);
-                Cv0 *= dynamics.rayleigh_mass;
-                Cv1 *= dynamics.rayleigh_mass;
+                  for (unsigned int j = 0; j < n; ++j)
+                    if (comp[i] == comp[j])
+                      M(i, j) += rho * fv.shape_value(i, q) * fv.shape_value(j, q) * w;
                 if (dynamics.rayleigh_stiffness > 0)
-                  {
-                    K0.vmult(tmp, v0);
-                    Cv0.add(dynamics.rayleigh_stiffness, tmp);
-                    K0.vmult(tmp, v1);
-                    Cv1.add(dynamics.rayleigh_stiffness, tmp);
-                  }
-                for (unsigned int i = 0; i < n; ++i)
-                  r[i] = Mv[i] + (1 + alpha) * (Cv1[i] + fi[i] - fx[i]) -
-                         alpha * (Cv0[i] + fi0[i] - fx0[i]);
-                if (matrix)
-                  {
-                    const double c_M = 1 / (beta * dt * dt) + (1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_mass;
-                    const double c_K0 = (1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_stiffness;
-                    for (unsigned int i = 0; i < n; ++i)
-                      for (unsigned int j = 0; j < n; ++j)
-                        A(i, j) = (1 + alpha) * A(i, j) + c_M * M(i, j) + c_K0 * K0(i, j);
-                  }
-                for (unsigned int i = 0; i < n; ++i)
-                  Mv[i] += Cv1[i];
-                inertia.add(dofs, Mv);
+                  for (unsigned int j = 0; j < n; ++j)
+                    {
+                      const SymmetricTensor<2, dim> DB = D * B[q][j];
+                      for (unsigned int i = 0; i < n; ++i)
+                        K0(i, j) += (B[q][i] * DB) * w;
+                    }
               }
-            else
+            fi0 = 0;
+            for (unsigned int q = 0; q < n_q; ++q)
               for (unsigned int i = 0; i < n; ++i)
-                r[i] = fi[i] - fx[i];
-
-            if (system)
+                fi0[i] += (B[q][i] * h.stress[q]) * h.weight[q];
+            external(cell, h, load0, fx0, fv, ffv);
+            for (unsigned int i = 0; i < n; ++i)
               {
-                r *= -1.0;
-                if (matrix)
-                  constraints.distribute_local_to_global(A, r, dofs, system_matrix, system_rhs, true);
-                else
-                  constraints.distribute_local_to_global(r, dofs, system_rhs);
+                v0[i] = v_ghost(dofs[i]);
+                a0[i] = a_ghost(dofs[i]);
+                a1[i] = (du[i] - dt * v0[i]) / (beta * dt * dt) - (1 - 2 * beta) / (2 * beta) * a0[i];
+                v1[i] = v0[i] + dt * ((1 - gamma) * a0[i] + gamma * a1[i]);
               }
-            f_int.add(dofs, fi);
-            f_ext.add(dofs, fx);
+            // C v = a0 M v + a1 K0 v.
+            M.vmult(Mv, a1);
+            M.vmult(Cv0, v0);
+            M.vmult(Cv1, v1);
+            Cv0 *= dynamics.rayleigh_mass;
+            Cv1 *= dynamics.rayleigh_mass;
+            if (dynamics.rayleigh_stiffness > 0)
+              {
+                K0.vmult(tmp, v0);
+                Cv0.add(dynamics.rayleigh_stiffness, tmp);
+                K0.vmult(tmp, v1);
+                Cv1.add(dynamics.rayleigh_stiffness, tmp);
+              }
+            for (unsigned int i = 0; i < n; ++i)
+              r[i] = Mv[i] + (1 + alpha) * (Cv1[i] + fi[i] - fx[i]) -
+                     alpha * (Cv0[i] + fi0[i] - fx0[i]);
+            if (matrix)
+              {
+                const double c_M = 1 / (beta * dt * dt) + (1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_mass;
+                const double c_K0 = (1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_stiffness;
+                for (unsigned int i = 0; i < n; ++i)
+                  for (unsigned int j = 0; j < n; ++j)
+                    A(i, j) = (1 + alpha) * A(i, j) + c_M * M(i, j) + c_K0 * K0(i, j);
+              }
+            for (unsigned int i = 0; i < n; ++i)
+              Mv[i] += Cv1[i];
           }
+        else
+          for (unsigned int i = 0; i < n; ++i)
+            r[i] = fi[i] - fx[i];
+        r *= -1.0;
+      };
+      bool        failed = false;
+      std::string message;
+      const auto  copier = [&](const Copy &c) {
+        if (!c.active)
+          return;
+        material_seconds += c.material_seconds;
+        if (c.failed)
+          {
+            if (!failed)
+              message = c.message;
+            failed = true;
+          }
+        if (failed)
+          return;
+        if (system)
+          {
+            if (matrix)
+              constraints.distribute_local_to_global(c.A, c.r, c.dofs, system_matrix, system_rhs, true);
+            else
+              constraints.distribute_local_to_global(c.r, c.dofs, system_rhs);
+          }
+        f_int.add(c.dofs, c.fi);
+        f_ext.add(c.dofs, c.fx);
+        if (dynamic)
+          inertia.add(c.dofs, c.Mv);
+      };
+      // Threads for this loop only (deal.II's other operations keep one). With more than one,
+      // FEValues computes every cell's geometry afresh instead of reusing that of a translated
+      // neighbour, so the results differ from one thread's at round-off; they are the same
+      // for any number of threads above one.
+      using Filtered = FilteredIterator<CellIterator>;
+      MultithreadInfo::set_thread_limit(threads);
+      try
+        {
+          WorkStream::run(Filtered(IteratorFilters::LocallyOwnedCell(), dof_handler.begin_active()),
+                          Filtered(IteratorFilters::LocallyOwnedCell(), dof_handler.end()),
+                          worker,
+                          copier,
+                          Scratch(mapping, *fe, *quadrature, *face_quadrature),
+                          Copy(n));
+        }
+      catch (...)
+        {
+          MultithreadInfo::set_thread_limit(1);
+          throw;
+        }
+      MultithreadInfo::set_thread_limit(1);
 
       // Forces shared by nodes (a load region without quadrature points).
       for (unsigned int l = 0; l < n_loads; ++l)

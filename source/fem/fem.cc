@@ -1,3 +1,4 @@
+#include <deal.II/base/multithread_info.h>
 #include <deal.II/base/utilities.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_q.h>
@@ -56,6 +57,16 @@ namespace hysteron
                           "Polynomial degree p of the FE_Q(p) displacement elements: 1 "
                           "(bilinear / trilinear) or 2 (biquadratic / triquadratic); Gauss "
                           "quadrature with p + 1 points per direction.");
+        prm.declare_entry("Threads",
+                          "1",
+                          Patterns::Integer(0),
+                          "Threads of the element loop (assembly and material updates) on each "
+                          "MPI rank; 0: the cores of the machine divided by the ranks. The cells' "
+                          "contributions are added in the order of the cells, so any number above "
+                          "one gives the same results; they differ from one thread's at round-off "
+                          "(deal.II then computes each cell's geometry afresh instead of reusing a "
+                          "translated neighbour's). A user material's update() must be safe to "
+                          "call from several threads (the shipped ones are).");
         prm.declare_entry("Analysis",
                           "quasi-static",
                           Patterns::Selection("quasi-static|implicit dynamics|explicit dynamics"),
@@ -177,6 +188,7 @@ namespace hysteron
       {
         Section s(prm, {"FEM"});
         degree                 = s.get_integer("Degree");
+        threads = s.get_integer("Threads");
         const std::string type = s.get("Analysis");
         analysis = type == "quasi-static"      ? Analysis::quasi_static :
                    type == "implicit dynamics" ? Analysis::implicit_dynamics :
@@ -267,6 +279,10 @@ namespace hysteron
     {
       const Scene<dim> &scene = this->get_scene();
       const auto       &time  = scene.time_control();
+      // The element loop's threads (everything else keeps the one MPI_InitFinalize sets).
+      if (threads == 0)
+        threads = std::max(1u, dealii::MultithreadInfo::n_cores() /
+                                 dealii::Utilities::MPI::n_mpi_processes(scene.mpi_communicator()));
       make_mesh();
       setup_system();
       setup_history();

@@ -208,6 +208,7 @@ namespace hysteron
       ImplicitDynamicsParameters dynamics;
       LinearSolver  solver_type = LinearSolver::automatic;
       unsigned long direct_limit = 100000;
+      unsigned int  threads      = 1; ///< `FEM/Threads` (0: the cores / the ranks)
       std::string   direct_package = "Amesos_Klu";
       double        solver_tolerance = 1e-10;
       unsigned int  solver_max_iterations = 5000;
