@@ -12,7 +12,6 @@ Q2, Bouc-Wen, 60 increments) and the implicit-dynamics cantilever of newton_fail
 
 Usage: threads.py HYSTERON WORKDIR
 """
-import csv
 import os
 import re
 import shutil
@@ -24,6 +23,9 @@ here = os.path.dirname(os.path.abspath(__file__))
 root = os.path.dirname(os.path.dirname(here))
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
+sys.path.insert(0, os.path.dirname(here))
+from table_comparison import compare_tables  # noqa: E402
+
 failures = []
 
 
@@ -40,39 +42,6 @@ def run(name, text, threads):
     return os.path.join(d, "output"), newton.group(1) if newton else None
 
 
-def tables(directory):
-    return sorted(f for f in os.listdir(directory) if f.endswith(".csv"))
-
-
-def compare(name, a, b, exact):
-    if tables(a) != tables(b) or not tables(a):
-        failures.append(f"{name}: tables {tables(a)} against {tables(b)}")
-        return
-    for table in tables(a):
-        ra = list(csv.reader(open(os.path.join(a, table))))
-        rb = list(csv.reader(open(os.path.join(b, table))))
-        if exact:
-            if ra != rb:
-                failures.append(f"{name}: {table} differs")
-            continue
-        if len(ra) != len(rb) or ra[:1] != rb[:1]:
-            failures.append(f"{name}: {table}: {len(ra)} rows against {len(rb)}")
-            continue
-        columns = []
-        for j, column in enumerate(ra[0]):
-            try:
-                columns.append((column, [float(r[j]) for r in ra[1:]], [float(r[j]) for r in rb[1:]]))
-            except ValueError:
-                pass
-        largest = max([abs(x) for _, xa, _ in columns for x in xa] + [1e-300])
-        for column, xa, xb in columns:
-            scale = max([abs(x) for x in xa] + [0.0])
-            for i, (x, y) in enumerate(zip(xa, xb)):
-                if abs(x - y) > max(1e-9 * scale, 1e-10 * largest):
-                    failures.append(f"{name}: {table}: column {column}, row {i + 1}: {x!r} vs {y!r}")
-                    break
-
-
 plastic = open(os.path.join(root, "prm", "fem_cantilever_plastic.prm")).read()
 plastic = re.sub(r"(?m)^(\s*set Write VTU\s*=).*$", r"\1 false", plastic)
 dynamic = "\n".join(l for l in open(os.path.join(here, "newton_failure_dynamics.prm")).read().splitlines()
@@ -83,8 +52,8 @@ for name, text in (("plastic", plastic), ("dynamic", dynamic)):
     one, n1 = run(name, text, 1)
     two, n2 = run(name, text, 2)
     three, n3 = run(name, text, 3)
-    compare(f"{name}: 2 against 3 threads", two, three, True)
-    compare(f"{name}: 1 against 2 threads", one, two, False)
+    failures += compare_tables(f"{name}: 2 against 3 threads", two, three, 0, 0, exact=True)
+    failures += compare_tables(f"{name}: 1 against 2 threads", one, two, 1e-9, 1e-10)
     if not (n1 == n2 == n3):
         failures.append(f"{name}: Newton iterations {n1}, {n2}, {n3} with 1, 2, 3 threads")
 

@@ -18,7 +18,6 @@ Tolerance: 1e-8 of each column's largest value, and 1e-9 of the largest value in
 
 Usage: incremental_assembly.py HYSTERON MPIEXEC WORKDIR
 """
-import csv
 import os
 import re
 import shutil
@@ -32,6 +31,9 @@ shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
 env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
            OMPI_MCA_rmaps_base_oversubscribe="1")
+sys.path.insert(0, os.path.dirname(here))
+from table_comparison import compare_tables  # noqa: E402
+
 failures = []
 
 
@@ -51,32 +53,6 @@ def run(name, text, incremental, ranks=1):
         sys.exit(f"{name}: exit {p.returncode}: {p.stderr[-2000:]}")
     summary = [line for line in p.stdout.splitlines() if "finished in" in line]
     return os.path.join(d, "output"), summary[-1] if summary else ""
-
-
-def compare(name, a, b):
-    """Every numeric column of every CSV table of a against b."""
-    tables = sorted(f for f in os.listdir(a) if f.endswith(".csv"))
-    if not tables:
-        failures.append(f"{name}: no tables in {a}")
-    for table in tables:
-        ra = list(csv.reader(open(os.path.join(a, table))))
-        rb = list(csv.reader(open(os.path.join(b, table))))
-        if len(ra) != len(rb) or ra[:1] != rb[:1]:
-            failures.append(f"{name}: {table}: {len(ra)} rows against {len(rb)} (or other columns)")
-            continue
-        columns = []
-        for j, column in enumerate(ra[0]):
-            try:
-                columns.append((column, [float(r[j]) for r in ra[1:]], [float(r[j]) for r in rb[1:]]))
-            except ValueError:
-                continue
-        largest = max([abs(x) for _, xa, _ in columns for x in xa] + [1e-300])
-        for column, xa, xb in columns:
-            scale = max([abs(x) for x in xa] + [0.0])
-            for i, (x, y) in enumerate(zip(xa, xb)):
-                if abs(x - y) > max(1e-8 * scale, 1e-9 * largest):
-                    failures.append(f"{name}: {table}: column {column}, row {i + 1}: {x!r} vs {y!r}")
-                    break
 
 
 def share(name, summary, at_most):
@@ -104,13 +80,14 @@ for name, text, at_most in (("static_rupture", rupture, 10), ("coupled_cantileve
                             ("dynamic_rupture", dynamic, 20)):
     a, summary = run(name, text, True)
     b, _ = run(name, text, False)
-    compare(name, a, b)
+    failures += compare_tables(name, a, b, 1e-8, 1e-9)
     share(name, summary, at_most)
     if "broken facets" not in summary or " 0 broken facets" in summary:
         failures.append(f"{name}: no facet broke: {summary}")
 
 a, summary = run("static_rupture", rupture, True, 2)
-compare("static_rupture, 2 ranks against 1", a, os.path.join(work, "static_rupture_full_1", "output"))
+failures += compare_tables("static_rupture, 2 ranks against 1", a,
+                           os.path.join(work, "static_rupture_full_1", "output"), 1e-8, 1e-9)
 share("static_rupture, 2 ranks", summary, 10)
 
 if failures:
