@@ -375,22 +375,28 @@ namespace hysteron
       // neighbour, so the results differ from one thread's at round-off; they are the same
       // for any number of threads above one.
       using Filtered = FilteredIterator<CellIterator>;
-      MultithreadInfo::set_thread_limit(threads);
-      try
+      // MPI_InitFinalize gives every method one thread; the guard raises the limit here only.
+      struct ThreadLimit
+      {
+        explicit ThreadLimit(const unsigned int n)
+          : raised(n > 1)
         {
-          WorkStream::run(Filtered(IteratorFilters::LocallyOwnedCell(), dof_handler.begin_active()),
-                          Filtered(IteratorFilters::LocallyOwnedCell(), dof_handler.end()),
-                          worker,
-                          copier,
-                          Scratch(mapping, *fe, *quadrature, *face_quadrature),
-                          Copy(n));
+          if (raised)
+            MultithreadInfo::set_thread_limit(n);
         }
-      catch (...)
+        ~ThreadLimit()
         {
-          MultithreadInfo::set_thread_limit(1);
-          throw;
+          if (raised)
+            MultithreadInfo::set_thread_limit(1);
         }
-      MultithreadInfo::set_thread_limit(1);
+        const bool raised;
+      } limit(threads);
+      WorkStream::run(Filtered(IteratorFilters::LocallyOwnedCell(), dof_handler.begin_active()),
+                      Filtered(IteratorFilters::LocallyOwnedCell(), dof_handler.end()),
+                      worker,
+                      copier,
+                      Scratch(mapping, *fe, *quadrature, *face_quadrature),
+                      Copy(n));
 
       // Forces shared by nodes (a load region without quadrature points).
       for (unsigned int l = 0; l < n_loads; ++l)

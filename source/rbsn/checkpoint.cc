@@ -134,24 +134,42 @@ namespace hysteron
 
 
 
+    namespace
+    {
+      /// Every stored value of the system matrix (this rank's rows of the Trilinos matrix,
+      /// or the serial matrix), in the pattern's order: @p visit gets a reference to it.
+      template <typename SerialMatrix, typename Visit>
+      void
+      for_each_matrix_value(const bool                                    trilinos,
+                            const dealii::TrilinosWrappers::SparseMatrix &parallel,
+                            SerialMatrix                                 &serial,
+                            Visit                                         visit)
+      {
+        if (!trilinos)
+          {
+            for (auto &entry : serial)
+              visit(entry.value());
+            return;
+          }
+        const Epetra_CrsMatrix &A = parallel.trilinos_matrix();
+        for (int row = 0; row < A.NumMyRows(); ++row)
+          {
+            int     n = 0;
+            double *a = nullptr;
+            A.ExtractMyRowView(row, n, a);
+            for (int j = 0; j < n; ++j)
+              visit(a[j]);
+          }
+      }
+    } // namespace
+
+
+
     std::vector<double>
     Model::matrix_values() const
     {
       std::vector<double> values;
-      if (trilinos_system())
-        {
-          const Epetra_CrsMatrix &A = parallel_matrix.trilinos_matrix();
-          for (int row = 0; row < A.NumMyRows(); ++row)
-            {
-              int     n = 0;
-              double *a = nullptr;
-              A.ExtractMyRowView(row, n, a);
-              values.insert(values.end(), a, a + n);
-            }
-        }
-      else
-        for (const auto &entry : matrix)
-          values.push_back(entry.value());
+      for_each_matrix_value(trilinos_system(), parallel_matrix, matrix, [&](const double v) { values.push_back(v); });
       return values;
     }
 
@@ -161,29 +179,15 @@ namespace hysteron
     Model::set_matrix_values(const std::vector<double> &values)
     {
       // The pattern is rebuilt by set-up as it was: the values go back in the same order.
-      std::size_t k = 0;
-      const auto  next = [&]() {
+      std::size_t k     = 0;
+      const auto  error = RuntimeError("the checkpoint's tangent matrix does not match the network's pattern");
+      for_each_matrix_value(trilinos_system(), parallel_matrix, matrix, [&](auto &&v) {
         if (k >= values.size())
-          throw RuntimeError("the checkpoint's tangent matrix does not match the network's pattern");
-        return values[k++];
-      };
-      if (trilinos_system())
-        {
-          const Epetra_CrsMatrix &A = parallel_matrix.trilinos_matrix();
-          for (int row = 0; row < A.NumMyRows(); ++row)
-            {
-              int     n = 0;
-              double *a = nullptr;
-              A.ExtractMyRowView(row, n, a);
-              for (int j = 0; j < n; ++j)
-                a[j] = next();
-            }
-        }
-      else
-        for (auto &entry : matrix)
-          entry.value() = next();
+          throw error;
+        v = values[k++];
+      });
       if (k != values.size())
-        throw RuntimeError("the checkpoint's tangent matrix does not match the network's pattern");
+        throw error;
     }
   } // namespace RBSN
 } // namespace hysteron

@@ -101,13 +101,10 @@ namespace hysteron
       // (beta dt) a1 K0.
       const auto facet_matrix = [&](const Springs &sp, const SpringLaw::Matrix &D, dealii::FullMatrix<double> &M) {
         spring_matrix(sp, D, M);
-        if (dynamic)
+        if (dynamic && dynamics.rayleigh_stiffness > 0)
           {
-            if (dynamics.rayleigh_stiffness > 0)
-              {
-                elastic_matrix(sp, K0);
-                M.add((1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_stiffness, K0);
-              }
+            elastic_matrix(sp, K0);
+            M.add((1 + alpha) * gamma / (beta * dt) * dynamics.rayleigh_stiffness, K0);
           }
       };
       const auto any_constrained = [&](const std::vector<dealii::types::global_dof_index> &indices) {
