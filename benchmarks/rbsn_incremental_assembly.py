@@ -115,7 +115,8 @@ def main():
     with open(args.output + ".md", "w") as f:
         f.write("# RBSN: incremental assembly of the tangent\n\n")
         f.write(f"`benchmarks/rbsn_incremental_assembly.py` (median of {repeats} runs of the `steps` "
-                "timer section, one core).\n\n")
+                "timer section, one core of the machine in the table at the top of doc/benchmarks.md, "
+                "Release build).\n\n")
         f.write("| " + " | ".join(rows[0]) + " |\n|" + "---|" * len(rows[0]) + "\n")
         for r in rows:
             f.write("| " + " | ".join(str(v) for v in r.values()) + " |\n")
