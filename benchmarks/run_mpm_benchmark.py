@@ -71,6 +71,7 @@ def main():
         points, steps = one[0][1], one[0][2]
         # Separate processes for the peak RSS: the big run and a one-cell block.
         small = with_entry(block, "Body block", "Shape", "box(0.7, 0.7, 0, 0.75, 0.75, 0.05)")
+        small = with_entry(small, "Output", "Probe points", "")  # the probe is off the one-cell block
         rss_big = subprocess_peak(hysteron, block, work)
         rss_small = subprocess_peak(hysteron, small, work)
         per_point = (rss_big - rss_small) * 1024 / points

@@ -5,12 +5,13 @@ Usage:
     doc/scripts/taylor_bar_metrics.py output/particles.csv 2     # 2D: axis x = 0, wall y = 0
     doc/scripts/taylor_bar_metrics.py output/particles.csv 3     # 3D: axis x = y = 0, wall z = 0
     doc/scripts/taylor_bar_metrics.py output/particles.csv 2 --points --height 0.0025
+    doc/scripts/taylor_bar_metrics.py output/particles.csv 3 --initial   # the same at t = 0
 
 Prints three numbers in cm on one line: L_f D_f D (D at --height above the wall, default
 0.25 cm), then nothing else, so that the output can be read by other scripts.
 
-Conventions (the scene files prm/mpm_taylor_bar_2d.prm and doc/scenes/mpm_taylor_bar_3d.prm
-follow them):
+Conventions (the scene files prm/mpm_taylor_bar_2d.prm, prm/mpm_taylor_bar_axisymmetric.prm
+and doc/scenes/mpm_taylor_bar_3d.prm follow them):
   - the bar axis is x = 0 (2D) or x = y = 0 (3D), the wall is the lowest grid face, the axial
     coordinate is the last one (x_y in 2D, x_z in 3D); half (2D) and quarter (3D) models with
     symmetry planes through the axis as well as full models work, since only the distance
@@ -30,6 +31,11 @@ height measured from the lowest point).
 The dp / 2 surface allowance is exact for undeformed straight boundaries and a first-order
 estimate otherwise (in 3D, on the curved mantle, the point nearest the surface lies less than
 dp / 2 inside it only on average). Report which convention was used.
+With --initial the metrics are those of the initial positions X = x - u: exactly L0 and D0 in
+2D (plane or axisymmetric), but D0 (1 + 0.0425) in 3D with 10 points across the radius, since
+the outermost point of a quarter disc filled with a square lattice lies 0.925 dp inside the
+mantle, not dp / 2: the 3D diameters carry this bias, and dividing by the --initial values
+removes it.
 """
 import argparse
 import csv
@@ -45,6 +51,8 @@ def main():
                         help="height of the diameter D above the bottom of the bar [m] (default 0.0025)")
     parser.add_argument("--points", action="store_true",
                         help="furthest-point distances (the dissertation's convention), no dp added")
+    parser.add_argument("--initial", action="store_true",
+                        help="the metrics of the initial positions x - u (the bias of the point lattice)")
     args = parser.parse_args()
 
     dim = args.dimension
@@ -57,11 +65,14 @@ def main():
         if key not in rows[0]:
             sys.exit(f"{args.csv}: no column {key} (is this a {dim}D particle table?)")
 
-    axial = [float(r["x_" + axial_name]) for r in rows]
+    def position(r, c):
+        return float(r["x_" + c]) - (float(r["u_" + c]) if args.initial else 0.0)
+
+    axial = [position(r, axial_name) for r in rows]
     if dim == 2:
-        radius = [abs(float(r["x_x"])) for r in rows]
+        radius = [abs(position(r, "x")) for r in rows]
     else:
-        radius = [math.hypot(float(r["x_x"]), float(r["x_y"])) for r in rows]
+        radius = [math.hypot(position(r, "x"), position(r, "y")) for r in rows]
 
     initial_axial = sorted({round(float(r["x_" + axial_name]) - float(r["u_" + axial_name]), 12)
                             for r in rows})

@@ -29,6 +29,15 @@ namespace hysteron
      * material in the load's region) and tractions t_l on the boundary faces in
      * the region.
      *
+     * Axisymmetric (x = r, w_q = JxW_q 2 pi r_q): the hoop strain eps_tt = u_r / r is a
+     * fourth strain component with the "B" of shape function i equal to
+     * n_i = N_i delta(c_i, x) / r, so that
+     *   f_int,i += sum_q n_i sigma_tt w_q,
+     *   K_ij    += sum_q (B_i : S n_j + n_i H : B_j + n_i C_tt n_j) w_q,
+     * with S = d sigma / d eps_tt, H = d sigma_tt / d eps and C_tt = d sigma_tt / d eps_tt
+     * (Material::HoopTangent; S = H = lambda I and C_tt = lambda + 2 mu for Hooke's law).
+     * The Gauss points lie inside the cells, so r_q > 0 also next to the axis.
+     *
      * Quasi-static: r = f_int(u) - f_ext(t1), tangent K.
      * HHT-alpha (Newmark for alpha = 0), beta = (1 - alpha)^2 / 4, gamma = 1/2 - alpha:
      *   a1 = (u1 - u0 - dt v0) / (beta dt^2) - (1 - 2 beta) / (2 beta) a0,
@@ -86,8 +95,9 @@ namespace hysteron
 
       // 2D: the thickness at a point of the body of the cell (weights hold it already).
       const auto thickness = [&](const CellHistory<dim> &h, const Point<dim> &x) {
-        return scene.body_descriptions()[h.body].thickness_at(x);
+        return scene.thickness_at(scene.body_descriptions()[h.body], x);
       };
+      const bool axisymmetric = scene.axisymmetric();
       // f += sum_q N_i (rho g + volume loads) w_q + tractions on the boundary faces
       // whose centre lies in the load's region (load values already scaled).
       const auto external = [&](const auto                        &cell,
@@ -181,6 +191,44 @@ namespace hysteron
         auto &C = scratch.C, &H = scratch.H;
         auto &A = out.A;
         auto &r = out.r, &fi = out.fi, &fx = out.fx, &Mv = out.Mv;
+        // Axisymmetric: add n_i sigma_tt w to @p f and (if @p K) the hoop terms of the
+        // tangent (see the top of this file) at point q, n_i = N_i delta(c_i, x) / r_q.
+        const auto add_hoop_terms = [&](const SymmetricTensor<2, dim> &S,
+                                        const SymmetricTensor<2, dim> &H_t,
+                                        const double                   C_tt,
+                                        const double                   sigma_tt,
+                                        const unsigned int             q,
+                                        const double                   r_q,
+                                        const double                   w,
+                                        FullMatrix<double>            *K,
+                                        dealii::Vector<double>        &f) {
+          const double inv_r = 1.0 / r_q;
+          for (unsigned int i = 0; i < n; ++i)
+            {
+              // nr: n_i; bs: B_i : S; hb: H : B_i.
+              const double nr = comp[i] == 0 ? fv.shape_value(i, q) * inv_r : 0.0;
+              double       bs = 0, hb = 0;
+              const auto   g  = fv.shape_grad(i, q);
+              for (unsigned int b = 0; b < dim; ++b)
+                {
+                  bs += S[comp[i]][b] * g[b];
+                  hb += H_t[comp[i]][b] * g[b];
+                }
+              f[i] += nr * sigma_tt * w;
+              if (K)
+                {
+                  // (n_i, B_i : S, H : B_i) in the scratch H (its matrix use at q is done)
+                  H[3 * i]     = nr;
+                  H[3 * i + 1] = bs;
+                  H[3 * i + 2] = hb;
+                }
+            }
+          if (K)
+            for (unsigned int i = 0; i < n; ++i)
+              for (unsigned int j = 0; j < n; ++j)
+                (*K)(i, j) += (H[3 * i + 1] * H[3 * j] + H[3 * i] * H[3 * j + 2] +
+                               H[3 * i] * C_tt * H[3 * j]) * w;
+        };
         auto &dofs = out.dofs;
         Mv = 0;
         fv.reinit(cell);
@@ -199,6 +247,14 @@ namespace hysteron
               if (du[i] != 0)
                 e += du[i] * B[q][i];
             h.increment[q] = e;
+            if (axisymmetric)
+              {
+                double u_r = 0;
+                for (unsigned int i = 0; i < n; ++i)
+                  if (comp[i] == 0 && du[i] != 0)
+                    u_r += du[i] * fv.shape_value(i, q);
+                h.hoop_increment[q] = u_r / h.point[q][0];
+              }
           }
 
         // The material: from the converged state to the trial state.
@@ -208,11 +264,20 @@ namespace hysteron
         if (update_material)
           try
             {
-              h.material->update(make_array_view(std::as_const(h.increment)),
-                                 make_array_view(h.trial_stress),
-                                 make_array_view(h.trial_state),
-                                 matrix ? make_array_view(h.tangent) :
-                                          ArrayView<SymmetricTensor<4, dim>>());
+              if (axisymmetric)
+                h.material->update_axisymmetric(
+                  make_array_view(std::as_const(h.increment)),
+                  make_array_view(std::as_const(h.hoop_increment)),
+                  make_array_view(h.trial_stress),
+                  make_array_view(h.trial_state),
+                  matrix ? make_array_view(h.tangent) : ArrayView<SymmetricTensor<4, dim>>(),
+                  matrix ? make_array_view(h.hoop_tangent) : ArrayView<Material::HoopTangent<dim>>());
+              else
+                h.material->update(make_array_view(std::as_const(h.increment)),
+                                   make_array_view(h.trial_stress),
+                                   make_array_view(h.trial_state),
+                                   matrix ? make_array_view(h.tangent) :
+                                            ArrayView<SymmetricTensor<4, dim>>());
             }
           catch (const RuntimeError &e)
             {
@@ -276,6 +341,16 @@ namespace hysteron
                       A(i, j) += v;
                     }
               }
+            if (axisymmetric)
+              add_hoop_terms(h.hoop_tangent[q].stress_by_hoop,
+                             h.hoop_tangent[q].hoop_by_strain,
+                             h.hoop_tangent[q].hoop_by_hoop,
+                             h.out_of_plane_stress(q, true),
+                             q,
+                             h.point[q][0],
+                             w,
+                             matrix ? &A : nullptr,
+                             fi);
           }
         external(cell, h, load1, fx, fv, ffv);
 
@@ -285,6 +360,9 @@ namespace hysteron
             M  = 0;
             K0 = 0;
             const SymmetricTensor<4, dim> D = h.material->elasticity().template stiffness<dim>();
+            const auto                   &el = h.material->elasticity();
+            const SymmetricTensor<2, dim> lambda_I = el.lame_lambda() * unit_symmetric_tensor<dim>();
+            fi0 = 0;
             for (unsigned int q = 0; q < n_q; ++q)
               {
                 const double w = h.weight[q];
@@ -299,11 +377,20 @@ namespace hysteron
                       for (unsigned int i = 0; i < n; ++i)
                         K0(i, j) += (B[q][i] * DB) * w;
                     }
+                for (unsigned int i = 0; i < n; ++i)
+                  fi0[i] += (B[q][i] * h.stress[q]) * w;
+                // Axisymmetric: the hoop terms of f_int(u0) and of the elastic K0.
+                if (axisymmetric)
+                  add_hoop_terms(lambda_I,
+                                 lambda_I,
+                                 el.lame_lambda() + 2.0 * el.shear_modulus(),
+                                 h.out_of_plane_stress(q, false),
+                                 q,
+                                 h.point[q][0],
+                                 w,
+                                 dynamics.rayleigh_stiffness > 0 ? &K0 : nullptr,
+                                 fi0);
               }
-            fi0 = 0;
-            for (unsigned int q = 0; q < n_q; ++q)
-              for (unsigned int i = 0; i < n; ++i)
-                fi0[i] += (B[q][i] * h.stress[q]) * h.weight[q];
             external(cell, h, load0, fx0, fv, ffv);
             for (unsigned int i = 0; i < n; ++i)
               {
@@ -439,15 +526,19 @@ namespace hysteron
     {
       (void)t1;
       using namespace dealii;
-      double work = 0;
+      double     work         = 0;
+      const bool axisymmetric = this->get_scene().axisymmetric();
       for (const auto &cell : triangulation.active_cell_iterators())
         if (cell->is_locally_owned())
           {
             CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
             for (unsigned int q = 0; q < h.stress.size(); ++q)
               {
-                // Trapezoidal internal work 1/2 (sigma_n + sigma_n+1) : d eps.
+                // Trapezoidal internal work 1/2 (sigma_n + sigma_n+1) : d eps (+ the hoop part).
                 work += 0.5 * ((h.stress[q] + h.trial_stress[q]) * h.increment[q]) * h.weight[q];
+                if (axisymmetric)
+                  work += 0.5 * (h.out_of_plane_stress(q, false) + h.out_of_plane_stress(q, true)) *
+                          h.hoop_increment[q] * h.weight[q];
                 h.strain[q] += h.increment[q];
               }
             h.stress.swap(h.trial_stress);

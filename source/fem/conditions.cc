@@ -215,7 +215,8 @@ namespace hysteron
                 for (const unsigned int f : cell->face_indices())
                   if (cell->face(f)->at_boundary() && load_regions[l]->contains(cell->face(f)->center(), tolerance))
                     {
-                      selected[l] += cell->face(f)->measure() * scene.body_descriptions()[h.body].thickness_at(cell->face(f)->center());
+                      selected[l] += cell->face(f)->measure() *
+                                     scene.thickness_at(scene.body_descriptions()[h.body], cell->face(f)->center());
                       cell_in_load[first + l] = true;
                     }
           }

@@ -172,6 +172,29 @@ namespace hysteron
           hi[d] = dealii::Utilities::MPI::max(hi[d], scene.mpi_communicator());
         }
       mesh_box = dealii::BoundingBox<dim>(std::make_pair(lo, hi));
+      if (scene.axisymmetric())
+        {
+          // x is the radius: no node at r < 0, and nodes on the axis need u_r = 0 (else
+          // the hoop strain u_r / r is unbounded next to them).
+          const double tol = 1e-9 * lo.distance(hi);
+          require(lo[0] >= -tol,
+                  "Method fem",
+                  "the mesh reaches x = " + std::to_string(lo[0]) +
+                    ", but x is the radius r >= 0 in an axisymmetric scene");
+          if (lo[0] <= tol)
+            {
+              dealii::Point<dim> on_axis = lo;
+              on_axis[1]                 = 0.5 * (lo[1] + hi[1]);
+              bool held                  = false;
+              for (const auto &b : scene.boundary_descriptions())
+                held = held || b.prescribes(on_axis, 0, lo, hi, tol);
+              require(held,
+                      "Boundary names",
+                      "the axisymmetric mesh reaches the axis x = 0 but no boundary condition "
+                      "holds the radial displacement there: add a Boundary with Type = roller "
+                      "and Faces = x- (u_r = 0 on the axis)");
+            }
+        }
       u_scale  = 0;
       for (unsigned int d = 0; d < dim; ++d)
         u_scale = std::max(u_scale, hi[d] - lo[d]);
@@ -217,10 +240,7 @@ namespace hysteron
               state_names = body_material[m]->state_variable_names();
             }
           consistent_tangent = consistent_tangent && body_material[m]->has_consistent_tangent();
-          // Hooke's law and the continuum Bouc-Wen tangents are symmetric; the
-          // algorithmic tangents of a general local Newton need not be.
-          symmetric_tangent = symmetric_tangent && (body_material[m]->n_state_variables() == 0 ||
-                                                    !body_material[m]->has_consistent_tangent());
+          symmetric_tangent = symmetric_tangent && body_material[m]->has_symmetric_tangent();
         }
 
       const unsigned long n_dofs = dof_handler.n_dofs();
@@ -285,10 +305,21 @@ namespace hysteron
             for (unsigned int q = 0; q < n_q; ++q)
               {
                 h.point[q]  = fv.quadrature_point(q);
-                h.weight[q] = fv.JxW(q) * bodies[h.body].thickness_at(h.point[q]);
+                h.weight[q] = fv.JxW(q) * this->get_scene().thickness_at(bodies[h.body], h.point[q]);
               }
             // Until a first evaluation: the elastic tangent (the first predictor).
             h.tangent.assign(n_q, h.material->elasticity().template stiffness<dim>());
+            if (this->get_scene().axisymmetric())
+              {
+                // Hooke's law with eps_tt the third normal strain.
+                const auto                &el = h.material->elasticity();
+                Material::HoopTangent<dim> elastic;
+                elastic.stress_by_hoop = el.lame_lambda() * dealii::unit_symmetric_tensor<dim>();
+                elastic.hoop_by_strain = elastic.stress_by_hoop;
+                elastic.hoop_by_hoop   = el.lame_lambda() + 2.0 * el.shear_modulus();
+                h.hoop_tangent.assign(n_q, elastic);
+                h.hoop_increment.assign(n_q, 0.0);
+              }
           }
     }
 

@@ -67,6 +67,10 @@ namespace hysteron
       for (unsigned int k = 0; k < constrained_list.size(); ++k)
         listed.emplace(constrained_list[k], k);
       RigidModeCheck<dim>                  check(centres, sizes);
+      // A solid of revolution has one rigid-body motion only, the translation along the
+      // axis (y): a radial "translation" or an in-plane rotation strains the hoop direction.
+      const bool                           axisymmetric = this->get_scene().axisymmetric();
+      std::vector<int>                     axially_held(n_parts, 0);
       std::vector<types::global_dof_index> dofs(fe->n_dofs_per_cell());
       for (const auto &cell : dof_handler.active_cell_iterators())
         if (cell->is_locally_owned())
@@ -77,15 +81,22 @@ namespace hysteron
             cell->get_dof_indices(dofs);
             for (const auto dof : dofs)
               if (const auto it = listed.find(dof); it != listed.end())
-                check.add_displacement(part[coarse->index()],
-                                       constrained_point[it->second],
-                                       constrained_component[it->second]);
+                {
+                  check.add_displacement(part[coarse->index()],
+                                         constrained_point[it->second],
+                                         constrained_component[it->second]);
+                  if (constrained_component[it->second] == 1)
+                    axially_held[part[coarse->index()]] = 1;
+                }
           }
       check.sum(this->get_scene().mpi_communicator());
+      Utilities::MPI::max(axially_held, this->get_scene().mpi_communicator(), axially_held);
 
       for (unsigned int p = 0; p < n_parts; ++p)
         {
-          const auto free = check.free_modes(p);
+          const auto free = axisymmetric ? (axially_held[p] ? std::vector<std::string>() :
+                                                              std::vector<std::string>{"translation in y, along the axis"}) :
+                                           check.free_modes(p);
           if (free.empty())
             continue;
           std::string where, modes;

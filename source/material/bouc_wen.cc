@@ -83,14 +83,16 @@ namespace hysteron
             y[L::i_eps_zz] = st[Slots::eps_zz];
         }
 
+        /// The Mandel strain increment; in 2D @p hoop is eps_zz' (0 in plane strain, the
+        /// hoop strain increment when axisymmetric).
         static void
-        strain(const dealii::SymmetricTensor<2, dim> &e, typename L::VecK &d)
+        strain(const dealii::SymmetricTensor<2, dim> &e, const double hoop, typename L::VecK &d)
         {
           for (unsigned int a = 0; a < L::K; ++a)
             {
               const unsigned int f = G::full[a];
               if (dim == 2 && f == 2)
-                d[a] = 0; // plane strain: eps_zz' = 0
+                d[a] = hoop;
               else
                 {
                   const auto ij = tensor_index<dim>(f);
@@ -138,25 +140,38 @@ namespace hysteron
             st[Slots::eps_zz] = y[L::i_eps_zz];
         }
 
+        /// The interface tangent from the Mandel one: T_ab / (w_a w_b). The zz row and
+        /// column (plane strain and axisymmetric: K = F, a = 2) go to @p hoop if given.
         static void
-        tangent(const typename L::MatK &T, dealii::SymmetricTensor<4, dim> &out)
+        tangent(const typename L::MatK            &T,
+                dealii::SymmetricTensor<4, dim>   &out,
+                HoopTangent<dim>                  *hoop)
         {
           for (unsigned int a = 0; a < L::K; ++a)
             {
               const unsigned int fa = G::full[a];
               if (dim == 2 && fa == 2)
-                continue; // plane strain: sigma_zz is not an interface component
+                continue; // sigma_zz is not an in-plane component
               const auto ij = tensor_index<dim>(fa);
               for (unsigned int b = 0; b < L::K; ++b)
                 {
                   const unsigned int fb = G::full[b];
                   if (dim == 2 && fb == 2)
-                    continue;
+                    {
+                      if (hoop)
+                        {
+                          hoop->stress_by_hoop[ij[0]][ij[1]] = T[a][b] / mandel_weight(fa);
+                          hoop->hoop_by_strain[ij[0]][ij[1]] = T[b][a] / mandel_weight(fa);
+                        }
+                      continue;
+                    }
                   const auto kl = tensor_index<dim>(fb);
                   out[ij[0]][ij[1]][kl[0]][kl[1]] =
                     T[a][b] / (mandel_weight(fa) * mandel_weight(fb));
                 }
             }
+          if (hoop && dim == 2 && L::K == 4)
+            hoop->hoop_by_hoop = T[2][2];
         }
       };
 
@@ -244,9 +259,11 @@ namespace hysteron
         update(const Constants                       &c,
                const unsigned int                     n_half,
                const dealii::SymmetricTensor<2, dim> &strain_increment,
+               const double                           hoop,
                dealii::SymmetricTensor<2, dim>       &stress,
                double                                *st,
-               dealii::SymmetricTensor<4, dim>       *tangent)
+               dealii::SymmetricTensor<4, dim>       *tangent,
+               HoopTangent<dim>                      *hoop_tangent)
         {
           double s[F], e[F], ep[F], De[F], d[F], Dd[F];
           for (unsigned int f = 0; f < F; ++f)
@@ -254,7 +271,7 @@ namespace hysteron
               if (dim == 2 && f == 2)
                 {
                   s[f] = ps ? 0.0 : st[Slots::sigma_zz];
-                  e[f] = 0.0;
+                  e[f] = hoop; // eps_zz': 0 in plane strain and plane stress
                 }
               else
                 {
@@ -317,7 +334,16 @@ namespace hysteron
                                        (a < nn && b < nn ? c.lambda_eff : 0.0);
                       (*tangent)[ij[0]][ij[1]][kl[0]][kl[1]] = D - gt * Dd[a] * Dd[b];
                     }
+                  if (hoop_tangent && nn == 3)
+                    {
+                      // The zz row and column (tensor form, D symmetric).
+                      const double D = a < nn ? c.lambda_eff : 0.0;
+                      hoop_tangent->stress_by_hoop[ij[0]][ij[1]] = D - gt * Dd[a] * Dd[2];
+                      hoop_tangent->hoop_by_strain[ij[0]][ij[1]] = D - gt * Dd[2] * Dd[a];
+                    }
                 }
+              if (hoop_tangent && nn == 3)
+                hoop_tangent->hoop_by_hoop = c.two_mu + c.lambda_eff - gt * Dd[2] * Dd[2];
             }
 
           // H1 of the end state.
@@ -357,6 +383,7 @@ namespace hysteron
         update_points(const Constants                       &c,
                       const unsigned int                     n_half,
                       const dealii::SymmetricTensor<2, dim> *strain_increment,
+                      const double                          *hoop,
                       dealii::SymmetricTensor<2, dim>       *stress,
                       double                                *st0,
                       const unsigned int                     size)
@@ -370,7 +397,7 @@ namespace hysteron
                   if (dim == 2 && f == 2)
                     {
                       s[k][f] = ps ? 0.0 : st[Slots::sigma_zz];
-                      e[k][f] = 0.0;
+                      e[k][f] = hoop ? hoop[k] : 0.0;
                     }
                   else
                     {
@@ -441,14 +468,30 @@ namespace hysteron
         }
       };
 
+      template <int dim>
+      bool
+      want_hoop_tangent(const dealii::ArrayView<dealii::SymmetricTensor<4, dim>> &tangents,
+                        const dealii::ArrayView<HoopTangent<dim>>                &hoop_tangents)
+      {
+        Assert(hoop_tangents.size() == 0 || hoop_tangents.size() == tangents.size(),
+               dealii::ExcDimensionMismatch(hoop_tangents.size(), tangents.size()));
+        (void)tangents;
+        return hoop_tangents.size() > 0;
+      }
+
+      /// One batch; @p hoop: null, or the hoop strain increments (axisymmetric), whose
+      /// tangent terms go to @p hoop_tangents if that is not empty.
       template <int dim, typename L, BoucWenIntegrator integrator>
       void
       run_batch(const Constants                                                &c,
                 const dealii::ArrayView<const dealii::SymmetricTensor<2, dim>> &strain_increments,
+                const double                                                   *hoop,
                 const dealii::ArrayView<dealii::SymmetricTensor<2, dim>>       &stresses,
                 const dealii::ArrayView<double>                                &states,
-                const dealii::ArrayView<dealii::SymmetricTensor<4, dim>>       &tangents)
+                const dealii::ArrayView<dealii::SymmetricTensor<4, dim>>       &tangents,
+                const dealii::ArrayView<HoopTangent<dim>>                      &hoop_tangents)
       {
+        const bool want_hoop = want_hoop_tangent(tangents, hoop_tangents);
         using P                             = Point<dim, L>;
         constexpr unsigned int size         = L::Slots::size;
         const bool             want_tangent = tangents.size() > 0;
@@ -465,15 +508,22 @@ namespace hysteron
             std::size_t        p      = 0;
             if (!want_tangent)
               for (; p + 4 <= strain_increments.size(); p += 4, st += 4 * size)
-                FE::template update_points<4>(
-                  c, n_half, &strain_increments[p], &stresses[p], st, size);
+                FE::template update_points<4>(c,
+                                              n_half,
+                                              &strain_increments[p],
+                                              hoop ? hoop + p : nullptr,
+                                              &stresses[p],
+                                              st,
+                                              size);
             for (; p < strain_increments.size(); ++p, st += size)
               FE::update(c,
                          n_half,
                          strain_increments[p],
+                         hoop ? hoop[p] : 0.0,
                          stresses[p],
                          st,
-                         want_tangent ? &tangents[p] : nullptr);
+                         want_tangent ? &tangents[p] : nullptr,
+                         want_hoop ? &hoop_tangents[p] : nullptr);
             return;
           }
 
@@ -493,7 +543,7 @@ namespace hysteron
                   for (unsigned int k = 0; k < n_points; ++k)
                     {
                       P::load(stresses[p + k], st + k * size, y[k]);
-                      P::strain(strain_increments[p + k], deps[k]);
+                      P::strain(strain_increments[p + k], hoop ? hoop[p + k] : 0.0, deps[k]);
                     }
                   L::template adaptive_points<n_points>(c, y, deps, r);
                   for (unsigned int k = 0; k < n_points; ++k)
@@ -508,7 +558,7 @@ namespace hysteron
           {
             double *st = states.data() + p * size;
             P::load(stresses[p], st, y);
-            P::strain(strain_increments[p], deps);
+            P::strain(strain_increments[p], hoop ? hoop[p] : 0.0, deps);
             double H1 = 0, H2 = 0;
             if constexpr (integrator == BoucWenIntegrator::forward_euler)
               {
@@ -532,7 +582,7 @@ namespace hysteron
               L::backward_euler(c, y, deps, H1, H2, want_tangent ? &T : nullptr);
             P::store(c, y, H1, H2, stresses[p], st);
             if (want_tangent)
-              P::tangent(T, tangents[p]);
+              P::tangent(T, tangents[p], want_hoop ? &hoop_tangents[p] : nullptr);
           }
       }
     } // namespace
@@ -615,7 +665,7 @@ namespace hysteron
               names[Slots::alpha + f] = std::string("alpha_") + components[f];
           }
         slot_epsp_zz = Slots::epsp + 2;
-        if (decltype(s)::value == StressState::plane_strain)
+        if (decltype(s)::value == StressState::plane_strain) // and axisymmetric
           {
             names[Slots::sigma_zz] = "sigma_zz";
             slot_sigma_zz          = Slots::sigma_zz;
@@ -657,30 +707,58 @@ namespace hysteron
       const dealii::ArrayView<double>                                &states,
       const dealii::ArrayView<dealii::SymmetricTensor<4, dim>>       &tangents) const
     {
+      update_batch(strain_increments, nullptr, stresses, states, tangents, {});
+    }
+
+    template <int dim>
+    void
+    BoucWen<dim>::update_axisymmetric(
+      const dealii::ArrayView<const dealii::SymmetricTensor<2, dim>> &strain_increments,
+      const dealii::ArrayView<const double>                          &hoop_increments,
+      const dealii::ArrayView<dealii::SymmetricTensor<2, dim>>       &stresses,
+      const dealii::ArrayView<double>                                &states,
+      const dealii::ArrayView<dealii::SymmetricTensor<4, dim>>       &tangents,
+      const dealii::ArrayView<HoopTangent<dim>>                      &hoop_tangents) const
+    {
+      // The plane-strain kernels with eps_zz' = the hoop strain rate: the same 3D law on
+      // the components xx, yy, zz, xy, with sigma_zz (= sigma_tt) in the state.
+      Assert(dim == 2 && stress_state == StressState::axisymmetric, dealii::ExcInternalError());
+      AssertDimension(hoop_increments.size(), strain_increments.size());
+      update_batch(
+        strain_increments, hoop_increments.data(), stresses, states, tangents, hoop_tangents);
+    }
+
+    template <int dim>
+    void
+    BoucWen<dim>::update_batch(
+      const dealii::ArrayView<const dealii::SymmetricTensor<2, dim>> &strain_increments,
+      const double                                                   *hoop_increments,
+      const dealii::ArrayView<dealii::SymmetricTensor<2, dim>>       &stresses,
+      const dealii::ArrayView<double>                                &states,
+      const dealii::ArrayView<dealii::SymmetricTensor<4, dim>>       &tangents,
+      const dealii::ArrayView<HoopTangent<dim>>                      &hoop_tangents) const
+    {
       dispatch<dim>(stress_state, kinematic, degrading, [&](auto s, auto k, auto d) {
         using L = Law<decltype(s)::value, decltype(k)::value, decltype(d)::value>;
+        const auto run = [&](auto integrator) {
+          run_batch<dim, L, decltype(integrator)::value>(constants,
+                                                        strain_increments,
+                                                        hoop_increments,
+                                                        stresses,
+                                                        states,
+                                                        tangents,
+                                                        hoop_tangents);
+        };
         switch (parameters.integrator)
           {
             case BoucWenIntegrator::forward_euler:
-              run_batch<dim, L, BoucWenIntegrator::forward_euler>(constants,
-                                                                  strain_increments,
-                                                                  stresses,
-                                                                  states,
-                                                                  tangents);
+              run(std::integral_constant<BoucWenIntegrator, BoucWenIntegrator::forward_euler>());
               break;
             case BoucWenIntegrator::adaptive:
-              run_batch<dim, L, BoucWenIntegrator::adaptive>(constants,
-                                                             strain_increments,
-                                                             stresses,
-                                                             states,
-                                                             tangents);
+              run(std::integral_constant<BoucWenIntegrator, BoucWenIntegrator::adaptive>());
               break;
             case BoucWenIntegrator::backward_euler:
-              run_batch<dim, L, BoucWenIntegrator::backward_euler>(constants,
-                                                                   strain_increments,
-                                                                   stresses,
-                                                                   states,
-                                                                   tangents);
+              run(std::integral_constant<BoucWenIntegrator, BoucWenIntegrator::backward_euler>());
               break;
           }
       });
@@ -694,7 +772,8 @@ namespace hysteron
                                double                                &eps_zz,
                                double                                &sigma_zz) const
     {
-      if (dim == 2 && stress_state == StressState::plane_strain)
+      if (dim == 2 && (stress_state == StressState::plane_strain ||
+                       stress_state == StressState::axisymmetric))
         {
           eps_zz   = 0;
           sigma_zz = state[slot_sigma_zz];

@@ -1,3 +1,4 @@
+#include <hysteron/base/exceptions.h>
 #include <hysteron/material/interface.h>
 
 #include <algorithm>
@@ -16,6 +17,8 @@ namespace hysteron
             return "plane stress";
           case StressState::plane_strain:
             return "plane strain";
+          case StressState::axisymmetric:
+            return "axisymmetric";
           default:
             return "3D";
         }
@@ -63,6 +66,20 @@ namespace hysteron
 
     template <int dim>
     void
+    Interface<dim>::update_axisymmetric(
+      const dealii::ArrayView<const dealii::SymmetricTensor<2, dim>> &,
+      const dealii::ArrayView<const double> &,
+      const dealii::ArrayView<dealii::SymmetricTensor<2, dim>> &,
+      const dealii::ArrayView<double> &,
+      const dealii::ArrayView<dealii::SymmetricTensor<4, dim>> &,
+      const dealii::ArrayView<HoopTangent<dim>> &) const
+    {
+      // create() refuses axisymmetric scenes for models without supports_axisymmetry().
+      AssertThrow(false, dealii::ExcNotImplemented());
+    }
+
+    template <int dim>
+    void
     Interface<dim>::out_of_plane(const dealii::SymmetricTensor<2, dim> &,
                                  const dealii::SymmetricTensor<2, dim> &stress,
                                  const dealii::ArrayView<const double> &,
@@ -92,10 +109,14 @@ namespace hysteron
                           Registry<3>::documentation());
       prm.declare_entry("Stress state",
                         "plane stress",
-                        Selection("plane stress|plane strain"),
+                        Selection("plane stress|plane strain|axisymmetric"),
                         "How a 2D model treats the third direction: 'plane stress' "
-                        "(sigma_zz = 0, thin bodies with an out-of-plane thickness) or "
-                        "'plane strain' (eps_zz = 0). Ignored in 3D.");
+                        "(sigma_zz = 0, thin bodies with an out-of-plane thickness), "
+                        "'plane strain' (eps_zz = 0) or 'axisymmetric' (a solid of "
+                        "revolution: x is the radius r >= 0, y the axis, the third "
+                        "direction the hoop direction with eps_tt = u_r / r; masses, "
+                        "volumes, loads and reactions are those of the whole ring, 2 pi r "
+                        "per unit of section area; MPM and FEM). Ignored in 3D.");
       prm.declare_entry("Young's modulus", "210e9", Double(), "Young's modulus E [Pa], > 0.");
       prm.declare_entry("Poisson's ratio",
                         "0.3",
@@ -116,12 +137,19 @@ namespace hysteron
       if (dim == 3)
         elasticity.stress_state = StressState::three_dimensional;
       else
-        elasticity.stress_state = section.get("Stress state") == "plane stress" ?
-                                    StressState::plane_stress :
-                                    StressState::plane_strain;
+        {
+          const std::string state = section.get("Stress state");
+          elasticity.stress_state = state == "plane stress" ? StressState::plane_stress :
+                                    state == "axisymmetric" ? StressState::axisymmetric :
+                                                              StressState::plane_strain;
+        }
 
       auto model = Registry<dim>::create(section.get("Model"), section.where("Model"));
       model->initialize(elasticity, section);
+      if (elasticity.stress_state == StressState::axisymmetric && !model->supports_axisymmetry())
+        throw InputError(section.where("Stress state"),
+                         "the model '" + section.get("Model") +
+                           "' has no axisymmetric form (it does not take the hoop strain)");
       return model;
     }
 

@@ -126,6 +126,10 @@ namespace hysteron
       tolerance = s.get_positive("Mixed control tolerance");
       material  = &this->get_scene().material(dealii::Utilities::trim(s.get("Material")),
                                              s.where("Material"));
+      require(material->elasticity().stress_state != Material::StressState::axisymmetric,
+              s.where("Material"),
+              "an axisymmetric material needs a solid of revolution (its hoop strain comes from "
+              "the radial displacement): drive a single point in 3D (Dimension = 3) instead");
 
       const auto free_names = s.get_list("Stress-free components");
       for (const auto &name : free_names)

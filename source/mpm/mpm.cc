@@ -210,6 +210,30 @@ namespace hysteron
               }
         }
       require(deformable, "Body names", "the mpm method needs at least one body that is not rigid");
+
+      axisymmetric = scene.axisymmetric();
+      if (axisymmetric)
+        {
+          // x is the radius: the grid may not reach r < 0, and a grid that reaches the
+          // axis needs v_r = 0 there (else the hoop strain v_r / r is unbounded).
+          require(lower[0] >= 0,
+                  "MPM/Grid/Lower corner",
+                  "x is the radius r in an axisymmetric scene, so the grid must start at "
+                  "r >= 0 (it starts at x = " + std::to_string(lower[0]) + ")");
+          if (lower[0] == 0)
+            {
+              dealii::Point<dim> on_axis = lower;
+              on_axis[1]                 = 0.5 * (lower[1] + upper[1]);
+              bool held                  = false;
+              for (const auto &b : scene.boundary_descriptions())
+                held = held || b.prescribes(on_axis, 0, lower, upper, 1e-9 * cell_size);
+              require(held,
+                      "Boundary names",
+                      "the axisymmetric grid reaches the axis (MPM/Grid/Lower corner x = 0) "
+                      "but no boundary condition holds the radial velocity there: add a "
+                      "Boundary with Type = roller and Faces = x- (v_r = 0 on the axis)");
+            }
+        }
     }
 
 

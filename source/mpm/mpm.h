@@ -43,6 +43,10 @@ namespace hysteron
      *  5. L_p = sum_i v_i (x) grad N_ip, d eps = sym(L_p) dt, F' = (I + L dt) F,
      *     V' = det F' V_0, stress and state by the material (optionally the
      *     Jaumann rotation sigma += (W sigma - sigma W) dt, W = skew L).
+     * Axisymmetric (x = r): V_p and m_p are those of the ring 2 pi r_p around the
+     * axis; f_i gains -sum_p N_ip V_p sigma_tt,p / r_p e_r (from the virtual hoop strain
+     * delta u_r / r), the material takes d eps_tt = dt sum_i N_ip v_i,r / r_p and
+     * V' = V det(I + L dt) (1 + d eps_tt).
      * USL takes v_i' in step 5 without the remap; USF updates the stress with
      * the velocities p_i / m_i of step 1 before the forces are computed.
      *
@@ -146,6 +150,8 @@ namespace hysteron
       std::string                   basis_name;
       double                        flip_fraction = 1.0;
       bool                          jaumann       = false;
+      /// x is the radius (Material/Stress state = axisymmetric): ring volumes, hoop terms.
+      bool                          axisymmetric  = false;
       double                        maximum_cfl   = 1.0;
       /// The critical step and the step of the step being taken (for failure messages).
       double                        step_critical = 0, step_dt = 0;
@@ -278,6 +284,35 @@ namespace hysteron
       static constexpr unsigned int                stress_chunk = 256;
       std::vector<dealii::SymmetricTensor<2, dim>> strain_increment =
         std::vector<dealii::SymmetricTensor<2, dim>>(stress_chunk);
+      std::vector<double> hoop_increment = std::vector<double>(stress_chunk); ///< axisymmetric
+
+      /// Axisymmetric: the hoop stress sigma_tt of point p (of a deformable group) in @p state.
+      double
+      hoop_stress(const typename ParticleStore<dim>::Group &group,
+                  const unsigned int                        p,
+                  const typename ParticleStore<dim>::State &state) const
+      {
+        double eps_zz = 0, sigma_tt = 0;
+        group.material->out_of_plane(
+          state.strain[p],
+          state.stress[p],
+          dealii::ArrayView<const double>(state.material_state.data() + group.state_offset +
+                                            std::size_t(p - group.begin) * group.n_state,
+                                          group.n_state),
+          eps_zz,
+          sigma_tt);
+        return sigma_tt;
+      }
+
+      /// Axisymmetric: V_p sigma_tt / r_p, the hoop part of the internal force of
+      /// point p (acting on its nodes with N_ip along -e_r); r_p at the step's start.
+      double
+      hoop_force(const typename ParticleStore<dim>::Group &group,
+                 const unsigned int                        p,
+                 const typename ParticleStore<dim>::State &state) const
+      {
+        return state.volume[p] * hoop_stress(group, p, state) / particles.current.x[p][0];
+      }
 
       // Diagnostics of the last step.
       double       max_speed            = 0; ///< max_p (c_p + |v_p|)

@@ -141,7 +141,8 @@ namespace hysteron
                     " sub-cells of each grid cell: refine the grid or raise `Particles per "
                     "cell`)");
           const auto  &group     = group_templates[group_of_body[b]];
-          // The point's share of the body: its sub-cell times the thickness there (2D).
+          // The point's share of the body: its sub-cell times the thickness there (2D;
+          // axisymmetric: times the circumference 2 pi r).
           const double cell_volume = std::pow(lattice.h / body.particles_per_cell, dim);
           const double density =
             scene.material(body.material, "Body " + body.name + "/Material").density();
@@ -154,7 +155,8 @@ namespace hysteron
                   if (loads[l].region.contains(x, 1e-9 * lattice.h))
                     load = l + 1;
               // On every rank (the same error everywhere if it is not > 0).
-              const double thickness = body.thickness_at(x);
+              // Axisymmetric: the ring around the axis, 2 pi r per unit of section area.
+              const double thickness = scene.thickness_at(body, x);
               const double volume    = cell_volume * thickness;
               ++load_count[load];
               load_volume[load] += volume;

@@ -148,9 +148,12 @@ namespace hysteron
               const Tensor<1, dim> mv = m * cur.v[p];
               if constexpr (with_forces)
                 {
-                  // f_i += N_ip (m_p g + f_p) - V_p sigma_p grad N_ip
-                  const Tensor<1, dim> f_ext =
+                  // f_i += N_ip (m_p g + f_p) - V_p sigma_p grad N_ip (axisymmetric: and
+                  // - N_ip V_p sigma_tt / r_p e_r, the hoop term, joins m_p g + f_p)
+                  Tensor<1, dim> f_ext =
                     m * gravity + particles.load_factor[p] * load_per_point[particles.load[p]];
+                  if (axisymmetric)
+                    f_ext[0] -= hoop_force(group, p, cur);
                   const SymmetricTensor<2, dim> vs = cur.volume[p] * cur.stress[p];
                   support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
                     double *const        r = node + std::size_t(n) * C;
@@ -200,9 +203,11 @@ namespace hysteron
             for (unsigned int p = group.begin; p < group.end; ++p)
               {
                 support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
-                const Tensor<1, dim> f_ext =
+                Tensor<1, dim> f_ext =
                   particles.mass[p] * gravity +
                   particles.load_factor[p] * load_per_point[particles.load[p]];
+                if (axisymmetric)
+                  f_ext[0] -= hoop_force(group, p, state);
                 const SymmetricTensor<2, dim> vs = state.volume[p] * state.stress[p];
                 support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
                   double *const        r = node + std::size_t(n) * C;
@@ -373,8 +378,9 @@ namespace hysteron
               for (unsigned int p = chunk; p < chunk_end; ++p)
                 {
                   support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
-                  Tensor<2, dim> L; // velocity gradient sum_i v_i (x) grad N_i
-                  support.for_each(g.s1, g.s2, [&](const unsigned int n, double, const Tensor<1, dim> &grad) {
+                  Tensor<2, dim> L;       // velocity gradient sum_i v_i (x) grad N_i
+                  double         v_r = 0; // sum_i N_i v_i,x (the radial velocity, axisymmetric)
+                  support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
                     const double *const r = node + std::size_t(n) * C;
                     if constexpr (midpoint)
                       {
@@ -385,17 +391,30 @@ namespace hysteron
                             for (unsigned int j = 0; j < dim; ++j)
                               L[i][j] += v * grad[j];
                           }
+                        v_r += N * (r[1] - 0.5 * r[1 + dim]);
                       }
                     else
-                      for (unsigned int i = 0; i < dim; ++i)
-                        for (unsigned int j = 0; j < dim; ++j)
-                          L[i][j] += r[1 + i] * grad[j];
+                      {
+                        for (unsigned int i = 0; i < dim; ++i)
+                          for (unsigned int j = 0; j < dim; ++j)
+                            L[i][j] += r[1 + i] * grad[j];
+                        v_r += N * r[1];
+                      }
                   });
                   const SymmetricTensor<2, dim> de = symmetrize(L) * dt;
                   strain_increment[p - chunk]      = de;
                   nxt.strain[p]                    = cur.strain[p] + de;
                   nxt.F[p]                         = (identity + dt * L) * cur.F[p];
-                  nxt.volume[p]                    = determinant(nxt.F[p]) * particles.volume0[p];
+                  if (axisymmetric)
+                    {
+                      // Hoop strain rate v_r / r; the ring's volume changes with the
+                      // in-plane area (det(I + dt L)) and the radius (1 + d eps_tt).
+                      const double hoop            = dt * v_r / cur.x[p][0];
+                      hoop_increment[p - chunk]    = hoop;
+                      nxt.volume[p] = cur.volume[p] * determinant(identity + dt * L) * (1.0 + hoop);
+                    }
+                  else
+                    nxt.volume[p] = determinant(nxt.F[p]) * particles.volume0[p];
                   if (jaumann)
                     {
                       // Jaumann rate: sigma' = C : d + W sigma - sigma W with the spin
@@ -414,15 +433,29 @@ namespace hysteron
                 std::memcpy(nxt.material_state.data() + offset,
                             cur.material_state.data() + offset,
                             n_state * sizeof(double));
-              group.material->update(view(strain_increment.data(), n_points),
-                                     view(nxt.stress.data() + chunk, n_points),
-                                     view(nxt.material_state.data() + offset, n_state),
-                                     ArrayView<SymmetricTensor<4, dim>>());
-              // Stress power, trapezoidal in time: dW = V sigma_mid : d eps.
+              if (axisymmetric)
+                group.material->update_axisymmetric(view(strain_increment.data(), n_points),
+                                                    view(hoop_increment.data(), n_points),
+                                                    view(nxt.stress.data() + chunk, n_points),
+                                                    view(nxt.material_state.data() + offset, n_state),
+                                                    ArrayView<SymmetricTensor<4, dim>>(),
+                                                    ArrayView<Material::HoopTangent<dim>>());
+              else
+                group.material->update(view(strain_increment.data(), n_points),
+                                       view(nxt.stress.data() + chunk, n_points),
+                                       view(nxt.material_state.data() + offset, n_state),
+                                       ArrayView<SymmetricTensor<4, dim>>());
+              // Stress power, trapezoidal in time: dW = V sigma_mid : d eps (+ V sigma_tt,mid
+              // d eps_tt when axisymmetric).
               double work = 0;
               for (unsigned int p = chunk; p < chunk_end; ++p)
                 work += 0.25 * (cur.volume[p] + nxt.volume[p]) *
                         ((cur.stress[p] + nxt.stress[p]) * strain_increment[p - chunk]);
+              if (axisymmetric)
+                for (unsigned int p = chunk; p < chunk_end; ++p)
+                  work += 0.25 * (cur.volume[p] + nxt.volume[p]) *
+                          (hoop_stress(group, p, cur) + hoop_stress(group, p, nxt)) *
+                          hoop_increment[p - chunk];
               if (!std::isfinite(work))
                 {
                   for (unsigned int p = chunk; p < chunk_end && failed_point < 0; ++p)

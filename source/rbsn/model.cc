@@ -259,6 +259,10 @@ namespace hysteron
             require(m.elasticity().stress_state != Material::StressState::three_dimensional,
                     "Body " + bodies[b].name + "/Material",
                     "the rbsn method is two-dimensional");
+            require(m.elasticity().stress_state != Material::StressState::axisymmetric,
+                    "Body " + bodies[b].name + "/Material",
+                    "the rbsn method has no axisymmetric form (its cells are plane rigid "
+                    "bodies): use Stress state = plane stress or plane strain");
             require(m.spring_behaviour().type != Material::SpringBehaviour::Type::none,
                     "Body " + bodies[b].name + "/Material",
                     "the rbsn method's springs follow the uniaxial Bouc-Wen law: the body's "

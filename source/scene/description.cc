@@ -212,7 +212,8 @@ namespace hysteron
                           "(doc/geometry.md). It weights the mass, volume, internal forces and "
                           "loads of the MPM's points (at each point), the FEM's quadrature points "
                           "and the RBSN's cells and facets; it must be > 0 wherever it is "
-                          "evaluated. Ignored in 3D.");
+                          "evaluated. Ignored in 3D; left at 1 in an axisymmetric scene (the "
+                          "ring 2 pi r takes its place).");
         prm.declare_entry("Initial velocity",
                           "",
                           Patterns::Anything(),

@@ -253,6 +253,7 @@ namespace hysteron
     bodies         = parse_bodies<dim>(prm, scene_names);
     for (const auto &b : bodies)
       material(b.material, "Body " + b.name + "/Material");
+    check_axisymmetry();
     boundaries = parse_boundaries<dim>(prm, scene_names);
     loads      = parse_loads<dim>(prm, scene_names);
     // Expressions of time only: NaN or infinity anywhere in [0, End time] is bad input.
@@ -288,6 +289,47 @@ namespace hysteron
         throw InputError(where, "no material named '" + name + "'; known: " + known);
       }
     return *it->second;
+  }
+
+  template <int dim>
+  void
+  Scene<dim>::check_axisymmetry()
+  {
+    using Material::StressState;
+    // A scene is axisymmetric as a whole: all its deformable bodies or none.
+    const BodyDescription<dim> *first = nullptr;
+    for (const auto &b : bodies)
+      if (!b.rigid)
+        {
+          const bool ax = material(b.material, "Body " + b.name + "/Material").elasticity().stress_state ==
+                          StressState::axisymmetric;
+          if (first == nullptr)
+            {
+              first         = &b;
+              axisymmetric_ = ax;
+            }
+          else if (ax != axisymmetric_)
+            throw InputError(material_subsection(b.material) + "/Stress state",
+                             "the material of Body " + b.name + " is " +
+                               (ax ? "" : "not ") + "axisymmetric but that of Body " +
+                               first->name + " is " + (axisymmetric_ ? "" : "not") +
+                               ": an axisymmetric scene has axisymmetric materials only");
+        }
+    if (!axisymmetric_)
+      return;
+    for (const auto &b : bodies)
+      {
+        // The ring's circumference 2 pi r takes the place of the thickness.
+        if (b.varying_thickness() || b.thickness != 1.0)
+          throw InputError("Body " + b.name + "/Thickness",
+                           "an axisymmetric body has no thickness (each point stands for the "
+                           "ring 2 pi r around the axis): leave it at 1");
+        const auto box = b.shape.bounding_box();
+        if (box.get_boundary_points().first[0] < 0)
+          throw InputError("Body " + b.name + "/Shape",
+                           "reaches x = " + std::to_string(box.get_boundary_points().first[0]) +
+                             " < 0, but x is the radius r >= 0 in an axisymmetric scene");
+      }
   }
 
   template <int dim>

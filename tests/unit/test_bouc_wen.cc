@@ -1251,3 +1251,128 @@ TEST(BoucWenTriaxialDegradation, DissipatedEnergyEqualsLoopArea)
       EXPECT_GT(loop, 5 * sy_ * eps_y_);
     }
 }
+
+TEST(BoucWenTriaxialStressState, AxisymmetricEquals3DWithHoopStrain)
+{
+  // Axisymmetric is the 3D law with eps_zz the hoop strain (eps_xz = eps_yz = 0): the same
+  // stresses (sigma_zz = sigma_tt from the state) and plastic strains for every integrator,
+  // and the tangent's hoop row and column are the 3D tangent's zz row and column. The path
+  // is in-plane cyclic plus a hoop strain of its own phase, well into the plastic range.
+  for (const std::string integrator : {"forward euler", "adaptive", "backward euler"})
+    for (const double m : {1.0, 0.3})
+      for (const bool degrading : {false, true})
+        {
+          SCOPED_TRACE(integrator + (degrading ? ", degrading" : "") + ", m = " + str(m));
+          Entries e = {{"Smoothness n", "8"},
+                       {"Post-yield stiffness ratio", "0.05"},
+                       {"Isotropic hardening fraction", str(m)},
+                       {"Integrator", integrator}};
+          if (degrading)
+            {
+              e["Degradation/Stiffness degradation c_eta"] = "1";
+              e["Degradation/Strength deterioration c_nu"] = "0.02";
+            }
+          const auto            m2 = make_material<2>(e, "axisymmetric");
+          const auto            m3 = make_material<3>(e);
+          std::vector<double>   st2(m2->n_state_variables()), st3(m3->n_state_variables());
+          SymmetricTensor<2, 2> s2;
+          SymmetricTensor<2, 3> s3, last;
+          m2->initialize_state(dealii::make_array_view(st2));
+          m3->initialize_state(dealii::make_array_view(st3));
+          double max_tangent_error = 0, max_tangent = 0;
+          for (unsigned int k = 1; k <= 300; ++k)
+            {
+              SymmetricTensor<2, 3> e3 = cyclic_path(k / 200.0);
+              e3[1][2]                 = 0;
+              e3[2][2]                 = 1.5 * eps_y_ * std::cos(2 * M_PI * k / 160.0) - 1.5 * eps_y_;
+              const SymmetricTensor<2, 3> d3 = e3 - last;
+              last                           = e3;
+              SymmetricTensor<2, 2>       d2;
+              for (unsigned int i = 0; i < 2; ++i)
+                for (unsigned int j = i; j < 2; ++j)
+                  d2[i][j] = d3[i][j];
+              const double                hoop = d3[2][2];
+              SymmetricTensor<4, 2>       T2;
+              SymmetricTensor<4, 3>       T3;
+              Material::HoopTangent<2>    H;
+              m2->update_axisymmetric(dealii::ArrayView<const SymmetricTensor<2, 2>>(&d2, 1),
+                                      dealii::ArrayView<const double>(&hoop, 1),
+                                      dealii::ArrayView<SymmetricTensor<2, 2>>(&s2, 1),
+                                      dealii::make_array_view(st2),
+                                      dealii::ArrayView<SymmetricTensor<4, 2>>(&T2, 1),
+                                      dealii::ArrayView<Material::HoopTangent<2>>(&H, 1));
+              m3->update_point(d3, s3, dealii::make_array_view(st3), &T3);
+              double eps_zz, sigma_tt;
+              m2->out_of_plane(SymmetricTensor<2, 2>(), s2, dealii::make_array_view(st2), eps_zz, sigma_tt);
+              for (unsigned int i = 0; i < 2; ++i)
+                for (unsigned int j = i; j < 2; ++j)
+                  ASSERT_NEAR(s2[i][j], s3[i][j], 1e-9 * sy_);
+              ASSERT_NEAR(sigma_tt, s3[2][2], 1e-9 * sy_);
+              ASSERT_NEAR(st2[slot(*m2, "eps_ps")], st3[slot(*m3, "eps_ps")], 1e-9 * eps_y_);
+              ASSERT_NEAR(st2[slot(*m2, "epsp_zz")], st3[slot(*m3, "epsp_zz")], 1e-9 * eps_y_);
+              const auto err = [&](const double a, const double b) {
+                max_tangent_error = std::max(max_tangent_error, std::abs(a - b));
+                max_tangent       = std::max(max_tangent, std::abs(b));
+              };
+              for (unsigned int i = 0; i < 2; ++i)
+                for (unsigned int j = 0; j < 2; ++j)
+                  {
+                    err(H.stress_by_hoop[i][j], T3[i][j][2][2]);
+                    err(H.hoop_by_strain[i][j], T3[2][2][i][j]);
+                    for (unsigned int k2 = 0; k2 < 2; ++k2)
+                      for (unsigned int l = 0; l < 2; ++l)
+                        err(T2[i][j][k2][l], T3[i][j][k2][l]);
+                  }
+              err(H.hoop_by_hoop, T3[2][2][2][2]);
+            }
+          EXPECT_LT(max_tangent_error, 1e-9 * max_tangent);
+          EXPECT_GT(st3[slot(*m3, "eps_ps")], 5 * eps_y_);
+          // The hoop strain matters: the plane-strain law on the same in-plane path differs.
+          EXPECT_GT(std::abs(st3[slot(*m3, "epsp_zz")]), 0.5 * eps_y_);
+        }
+}
+
+TEST(LinearElastic, AxisymmetricEquals3DHookeWithHoopStrain)
+{
+  // sigma = lambda tr(eps) 1 + 2 mu eps with eps_zz = eps_tt, sigma_tt in the one state slot.
+  dealii::ParameterHandler prm;
+  prm.enter_subsection("Material");
+  Material::declare_parameters(prm);
+  prm.set("Stress state", "axisymmetric");
+  prm.set("Young's modulus", "200e9");
+  prm.set("Poisson's ratio", "0.3");
+  prm.leave_subsection();
+  const auto            m2 = Material::create<2>(Section(prm, {"Material"}));
+  const auto            m3 = Material::create<3>(Section(prm, {"Material"}));
+  SymmetricTensor<2, 2> d2, s2;
+  SymmetricTensor<2, 3> d3, s3;
+  d3[0][0] = d2[0][0] = 1e-3;
+  d3[1][1] = d2[1][1] = -4e-4;
+  d3[0][1] = d2[0][1] = 2.5e-4;
+  d3[2][2]            = 7e-4;
+  const double          hoop = d3[2][2];
+  ASSERT_EQ(m2->n_state_variables(), 1u);
+  std::vector<double>      state(1, 0.0);
+  SymmetricTensor<4, 2>    T2;
+  Material::HoopTangent<2> H;
+  m2->update_axisymmetric(dealii::ArrayView<const SymmetricTensor<2, 2>>(&d2, 1),
+                          dealii::ArrayView<const double>(&hoop, 1),
+                          dealii::ArrayView<SymmetricTensor<2, 2>>(&s2, 1),
+                          dealii::make_array_view(state),
+                          dealii::ArrayView<SymmetricTensor<4, 2>>(&T2, 1),
+                          dealii::ArrayView<Material::HoopTangent<2>>(&H, 1));
+  SymmetricTensor<4, 3> T3;
+  m3->update_point(d3, s3, dealii::ArrayView<double>(), &T3);
+  for (unsigned int i = 0; i < 2; ++i)
+    for (unsigned int j = 0; j < 2; ++j)
+      {
+        EXPECT_NEAR(s2[i][j], s3[i][j], 1e-6);
+        EXPECT_NEAR(H.stress_by_hoop[i][j], T3[i][j][2][2], 1e-3);
+        EXPECT_NEAR(H.hoop_by_strain[i][j], T3[2][2][i][j], 1e-3);
+      }
+  double eps_zz, sigma_tt;
+  m2->out_of_plane(SymmetricTensor<2, 2>(), s2, dealii::make_array_view(state), eps_zz, sigma_tt);
+  EXPECT_NEAR(sigma_tt, s3[2][2], 1e-6);
+  EXPECT_NEAR(H.hoop_by_hoop, T3[2][2][2][2], 1e-3);
+  EXPECT_GT(std::abs(sigma_tt), 1e8);
+}

@@ -74,8 +74,29 @@ namespace hysteron
       std::vector<dealii::SymmetricTensor<2, dim>> trial_stress, increment;
       std::vector<double>                          trial_state;
       std::vector<dealii::SymmetricTensor<4, dim>> tangent;
-      std::vector<double>                          weight; ///< JxW times the thickness t(x_q)
+      /// Axisymmetric only (else empty): the hoop strain increments u_r / r and the tangent
+      /// terms of the hoop strain.
+      std::vector<double>                               hoop_increment;
+      std::vector<Material::HoopTangent<dim>>           hoop_tangent;
+      /// JxW times the thickness t(x_q) (axisymmetric: times 2 pi r_q)
+      std::vector<double>                          weight;
       std::vector<dealii::Point<dim>>              point;  ///< quadrature points (reference configuration)
+
+      /// 2D: sigma_zz at point q of the trial (or the converged) state (the hoop stress
+      /// of an axisymmetric model).
+      double
+      out_of_plane_stress(const unsigned int q, const bool trial) const
+      {
+        double eps_zz = 0, sigma_zz = 0;
+        material->out_of_plane(strain[q],
+                               trial ? trial_stress[q] : stress[q],
+                               dealii::ArrayView<const double>((trial ? trial_state : state).data() +
+                                                                 q * n_state,
+                                                               n_state),
+                               eps_zz,
+                               sigma_zz);
+        return sigma_zz;
+      }
     };
 
     /// See the namespace documentation.

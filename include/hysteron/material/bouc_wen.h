@@ -31,7 +31,8 @@ namespace hysteron
      * source/material/bouc_wen_kernels.h for the derivations, the integrators and the state layout.
      *
      * Stress states: 3D (full tensors), plane strain (the 3D law with eps_zz' = 0;
-     * sigma_zz is carried in the state) and plane stress (reduced xx, yy, xy forms
+     * sigma_zz is carried in the state), axisymmetric (the same with eps_zz' the hoop
+     * strain rate u_r' / r) and plane stress (reduced xx, yy, xy forms
      * with the plane-stress stiffness; the zz components of the plastic strain and
      * back stress follow from plastic incompressibility).
      *
@@ -76,6 +77,21 @@ namespace hysteron
              const dealii::ArrayView<double>                                &states,
              const dealii::ArrayView<dealii::SymmetricTensor<4, dim>> &tangents) const override;
 
+      bool
+      supports_axisymmetry() const override
+      {
+        return true;
+      }
+
+      void
+      update_axisymmetric(
+        const dealii::ArrayView<const dealii::SymmetricTensor<2, dim>> &strain_increments,
+        const dealii::ArrayView<const double>                          &hoop_increments,
+        const dealii::ArrayView<dealii::SymmetricTensor<2, dim>>       &stresses,
+        const dealii::ArrayView<double>                                &states,
+        const dealii::ArrayView<dealii::SymmetricTensor<4, dim>>       &tangents,
+        const dealii::ArrayView<HoopTangent<dim>> &hoop_tangents) const override;
+
       /// Plane stress: eps_zz from the state; plane strain: sigma_zz from the state.
       void
       out_of_plane(const dealii::SymmetricTensor<2, dim> &strain,
@@ -109,6 +125,16 @@ namespace hysteron
       parse_parameters(const Section &section) override;
 
     private:
+      /// update() and update_axisymmetric(): @p hoop_increments null or n values.
+      void
+      update_batch(
+        const dealii::ArrayView<const dealii::SymmetricTensor<2, dim>> &strain_increments,
+        const double                                                   *hoop_increments,
+        const dealii::ArrayView<dealii::SymmetricTensor<2, dim>>       &stresses,
+        const dealii::ArrayView<double>                                &states,
+        const dealii::ArrayView<dealii::SymmetricTensor<4, dim>>       &tangents,
+        const dealii::ArrayView<HoopTangent<dim>>                      &hoop_tangents) const;
+
       BoucWenParameters         parameters;
       BoucWenKernels::Constants constants;
       StressState               stress_state = StressState::three_dimensional;

@@ -12,14 +12,18 @@ namespace hysteron
     /**
      * How a two-dimensional model relates to the third direction.
      * plane stress: sigma_zz = sigma_xz = sigma_yz = 0, eps_zz follows from the law;
-     * plane strain: eps_zz = eps_xz = eps_yz = 0, sigma_zz follows from the law.
+     * plane strain: eps_zz = eps_xz = eps_yz = 0, sigma_zz follows from the law;
+     * axisymmetric: x is the radius r >= 0, y the axis and z the hoop direction t;
+     * eps_tt = u_r / r is given by the kinematics (eps_rt = eps_zt = 0), sigma_tt
+     * follows from the law; the in-plane stiffness is that of plane strain.
      * Three-dimensional models always use three_dimensional.
      */
     enum class StressState
     {
       plane_stress,
       plane_strain,
-      three_dimensional
+      three_dimensional,
+      axisymmetric
     };
 
     std::string

@@ -38,6 +38,19 @@ namespace hysteron
     };
 
     /**
+     * The terms of an axisymmetric tangent besides the in-plane d sigma / d eps:
+     * the coupling with the hoop strain eps_tt (d sigma_tt = hoop_by_strain : d eps +
+     * hoop_by_hoop d eps_tt, d sigma = C : d eps + stress_by_hoop d eps_tt).
+     */
+    template <int dim>
+    struct HoopTangent
+    {
+      dealii::SymmetricTensor<2, dim> stress_by_hoop; ///< d sigma_ij / d eps_tt
+      dealii::SymmetricTensor<2, dim> hoop_by_strain; ///< d sigma_tt / d eps_kl
+      double                          hoop_by_hoop = 0; ///< d sigma_tt / d eps_tt
+    };
+
+    /**
      * The interface of every constitutive model (deal.II style: a class
      * templated on dim; SymmetricTensor at the interface).
      *
@@ -118,6 +131,30 @@ namespace hysteron
              const dealii::ArrayView<double>                                &states,
              const dealii::ArrayView<dealii::SymmetricTensor<4, dim>>       &tangents) const = 0;
 
+      /// Whether update_axisymmetric() is implemented (default: no; create() then
+      /// refuses `Stress state = axisymmetric` with the model's name).
+      virtual bool
+      supports_axisymmetry() const
+      {
+        return false;
+      }
+
+      /**
+       * Axisymmetric 2D (`Stress state = axisymmetric`: x the radius, y the axis, z
+       * the hoop direction): update() with the hoop strain increments d eps_tt
+       * (u_r / r) besides the in-plane ones. The hoop stress sigma_tt is part of the
+       * state and read with out_of_plane() (as sigma_zz). @p hoop_tangents is empty
+       * or receives, with @p tangents, the terms that couple eps_tt.
+       */
+      virtual void
+      update_axisymmetric(
+        const dealii::ArrayView<const dealii::SymmetricTensor<2, dim>> &strain_increments,
+        const dealii::ArrayView<const double>                          &hoop_increments,
+        const dealii::ArrayView<dealii::SymmetricTensor<2, dim>>       &stresses,
+        const dealii::ArrayView<double>                                &states,
+        const dealii::ArrayView<dealii::SymmetricTensor<4, dim>>       &tangents,
+        const dealii::ArrayView<HoopTangent<dim>>                      &hoop_tangents) const;
+
       /// update() for one point.
       void
       update_point(const dealii::SymmetricTensor<2, dim> &strain_increment,
@@ -130,7 +167,8 @@ namespace hysteron
        * (plane strain) of a point with in-plane @p strain, @p stress and @p state;
        * the other one is zero. The default is the elastic relation
        * eps_zz = -nu/E (s_xx + s_yy), resp. sigma_zz = nu (s_xx + s_yy);
-       * inelastic models override it.
+       * inelastic models override it. Axisymmetric models return the hoop stress
+       * as sigma_zz and eps_zz = 0 (the hoop strain is known to the caller).
        */
       virtual void
       out_of_plane(const dealii::SymmetricTensor<2, dim> &strain,
@@ -148,6 +186,17 @@ namespace hysteron
       has_consistent_tangent() const
       {
         return true;
+      }
+
+      /**
+       * Whether the tangents of update() are symmetric, so that CG may solve with them
+       * (default: a model without state (Hooke's law) or with the continuum Bouc-Wen
+       * tangent; the algorithmic tangent of a general local Newton need not be).
+       */
+      virtual bool
+      has_symmetric_tangent() const
+      {
+        return n_state_variables() == 0 || !has_consistent_tangent();
       }
 
       /// What springs between cells of this material follow (default: none, the

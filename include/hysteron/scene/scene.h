@@ -117,6 +117,27 @@ namespace hysteron
       return loads;
     }
 
+    /**
+     * Whether the scene is a solid of revolution (`Stress state = axisymmetric` in the
+     * materials of its deformable bodies): x is the radius r >= 0, y the axis.
+     */
+    bool
+    axisymmetric() const
+    {
+      return axisymmetric_;
+    }
+
+    /**
+     * What multiplies a section area (2D) into a volume at the point @p x of @p body:
+     * the body's thickness there, or 2 pi x (the ring around the axis) when the scene
+     * is axisymmetric; 1 in 3D.
+     */
+    double
+    thickness_at(const BodyDescription<dim> &body, const dealii::Point<dim> &x) const
+    {
+      return axisymmetric_ ? 2.0 * dealii::numbers::PI * x[0] : body.thickness_at(x);
+    }
+
     /// `Gravity` [m/s^2].
     const dealii::Tensor<1, dim> &
     gravity() const
@@ -240,6 +261,11 @@ namespace hysteron
     void
     parse(dealii::ParameterHandler &prm);
 
+    /// Set axisymmetric_ and check the bodies against it (one kind of material, no
+    /// thickness, x >= 0).
+    void
+    check_axisymmetry();
+
     RunOptions                                                      options;
     mutable dealii::ConditionalOStream                              pcout;
     /// Created first and destroyed while a parse error is still caught: a
@@ -255,6 +281,7 @@ namespace hysteron
     OutputControl<dim>                                              output;
     CheckpointControl                                               checkpoint;
     unsigned int                                                    seed = 0;
+    bool                                                            axisymmetric_ = false;
     std::string                                                     effective_parameters_;
     std::unique_ptr<Methods::Interface<dim>>                        method;
   };
