@@ -23,7 +23,7 @@ namespace hysteron
       const auto        &s     = dirichlet[constrained_set[k]];
       const unsigned int c     = constrained_component[k];
       if (s.rigid >= 0)
-        return integrate_in_time<dim>(*scene.body_descriptions()[s.rigid].rigid_velocity, t0, t1)[c];
+        return scene.body_descriptions()[s.rigid].rigid_displacement(t0, t1)[c];
       const auto &d = scene.boundary_descriptions()[s.boundary];
       if (d.velocity || d.displacement)
         return d.displacement_increment(t0, t1, constrained_point[k])[c];
@@ -40,10 +40,10 @@ namespace hysteron
       const auto        &s     = dirichlet[constrained_set[k]];
       const unsigned int c     = constrained_component[k];
       if (s.rigid >= 0)
-        return evaluate_in_time<dim>(*scene.body_descriptions()[s.rigid].rigid_velocity, t)[c];
+        return scene.body_descriptions()[s.rigid].rigid_velocity_at(t)[c];
       const auto &d = scene.boundary_descriptions()[s.boundary];
       if (d.velocity)
-        return evaluate_in_time<dim>(*d.velocity, t)[c];
+        return d.velocity_at(t)[c];
       if (d.displacement && dt > 0)
         return d.step_velocity(t, dt, constrained_point[k])[c];
       return 0;

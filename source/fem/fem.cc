@@ -314,6 +314,12 @@ namespace hysteron
       else if (nominal == 0)
         nominal = time.end_time / n_increments;
       increments   = IncrementControl(nominal, newton.max_cuts);
+      if (analysis != Analysis::explicit_dynamics && !time.steps.empty())
+        {
+          std::vector<double> ends, nominals;
+          time.step_grid(ends, nominals);
+          increments.set_steps(ends, nominals);
+        }
       step_checked = false;
     }
 

@@ -167,7 +167,7 @@ namespace hysteron
           std::vector<dealii::Tensor<1, dim>> v(bodies.size());
           for (unsigned int b = 0; b < bodies.size(); ++b)
             if (bodies[b].rigid)
-              v[b] = evaluate_in_time<dim>(*bodies[b].rigid_velocity, t);
+              v[b] = bodies[b].rigid_velocity_at(t);
           for (const unsigned int n : rigid_nodes)
             {
               double *const r = node + std::size_t(n) * C;

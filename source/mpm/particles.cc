@@ -184,7 +184,7 @@ namespace hysteron
               properties[PI::body]      = b;
               properties[PI::load]      = load;
               const Tensor<1, dim> v =
-                body.rigid ? evaluate_in_time<dim>(*body.rigid_velocity, 0.0) : body.velocity_at(x);
+                body.rigid ? body.rigid_velocity_at(0.0) : body.velocity_at(x);
               for (unsigned int d = 0; d < dim; ++d)
                 {
                   properties[PI::velocity + d]                       = v[d];

@@ -152,7 +152,7 @@ namespace hysteron
                   // - N_ip V_p sigma_tt / r_p e_r, the hoop term, joins m_p g + f_p)
                   Tensor<1, dim> f_ext =
                     m * gravity + particles.load_factor[p] * load_per_point[particles.load[p]];
-                  if (axisymmetric)
+                  if (dim == 2 && axisymmetric)
                     f_ext[0] -= hoop_force(group, p, cur);
                   const SymmetricTensor<2, dim> vs = cur.volume[p] * cur.stress[p];
                   support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
@@ -206,7 +206,7 @@ namespace hysteron
                 Tensor<1, dim> f_ext =
                   particles.mass[p] * gravity +
                   particles.load_factor[p] * load_per_point[particles.load[p]];
-                if (axisymmetric)
+                if (dim == 2 && axisymmetric)
                   f_ext[0] -= hoop_force(group, p, state);
                 const SymmetricTensor<2, dim> vs = state.volume[p] * state.stress[p];
                 support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
@@ -245,12 +245,9 @@ namespace hysteron
         {
           if (group.material == nullptr)
             {
-              const Tensor<1, dim> v_mid =
-                evaluate_in_time<dim>(*this->get_scene().body_descriptions()[group.rigid_body].rigid_velocity,
-                                      t + 0.5 * dt);
-              const Tensor<1, dim> v_end =
-                evaluate_in_time<dim>(*this->get_scene().body_descriptions()[group.rigid_body].rigid_velocity,
-                                      t + dt);
+              const auto          &rigid = this->get_scene().body_descriptions()[group.rigid_body];
+              const Tensor<1, dim> v_mid = rigid.rigid_velocity_at(t + 0.5 * dt);
+              const Tensor<1, dim> v_end = rigid.rigid_velocity_at(t + dt);
               for (unsigned int p = group.begin; p < group.end; ++p)
                 {
                   nxt.v[p] = v_end;
@@ -378,9 +375,8 @@ namespace hysteron
               for (unsigned int p = chunk; p < chunk_end; ++p)
                 {
                   support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
-                  Tensor<2, dim> L;       // velocity gradient sum_i v_i (x) grad N_i
-                  double         v_r = 0; // sum_i N_i v_i,x (the radial velocity, axisymmetric)
-                  support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
+                  Tensor<2, dim> L; // velocity gradient sum_i v_i (x) grad N_i
+                  support.for_each(g.s1, g.s2, [&](const unsigned int n, double, const Tensor<1, dim> &grad) {
                     const double *const r = node + std::size_t(n) * C;
                     if constexpr (midpoint)
                       {
@@ -391,24 +387,26 @@ namespace hysteron
                             for (unsigned int j = 0; j < dim; ++j)
                               L[i][j] += v * grad[j];
                           }
-                        v_r += N * (r[1] - 0.5 * r[1 + dim]);
                       }
                     else
-                      {
-                        for (unsigned int i = 0; i < dim; ++i)
-                          for (unsigned int j = 0; j < dim; ++j)
-                            L[i][j] += r[1 + i] * grad[j];
-                        v_r += N * r[1];
-                      }
+                      for (unsigned int i = 0; i < dim; ++i)
+                        for (unsigned int j = 0; j < dim; ++j)
+                          L[i][j] += r[1 + i] * grad[j];
                   });
                   const SymmetricTensor<2, dim> de = symmetrize(L) * dt;
                   strain_increment[p - chunk]      = de;
                   nxt.strain[p]                    = cur.strain[p] + de;
                   nxt.F[p]                         = (identity + dt * L) * cur.F[p];
-                  if (axisymmetric)
+                  if (dim == 2 && axisymmetric)
                     {
-                      // Hoop strain rate v_r / r; the ring's volume changes with the
-                      // in-plane area (det(I + dt L)) and the radius (1 + d eps_tt).
+                      // Hoop strain rate v_r / r (v_r = sum_i N_i v_i,x, a second pass so
+                      // that plane and 3D scenes pay nothing); the ring's volume changes with
+                      // the in-plane area (det(I + dt L)) and the radius (1 + d eps_tt).
+                      double v_r = 0;
+                      support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &) {
+                        const double *const r = node + std::size_t(n) * C;
+                        v_r += N * (midpoint ? r[1] - 0.5 * r[1 + dim] : r[1]);
+                      });
                       const double hoop            = dt * v_r / cur.x[p][0];
                       hoop_increment[p - chunk]    = hoop;
                       nxt.volume[p] = cur.volume[p] * determinant(identity + dt * L) * (1.0 + hoop);

@@ -634,7 +634,7 @@ namespace hysteron
     {
       const unsigned int c = dof / 3, k = dof % 3;
       if (set.rigid >= 0)
-        return k < 2 ? integrate_in_time<2>(*scene.body_descriptions()[set.rigid].rigid_velocity, t0, t1)[k] : 0.0;
+        return k < 2 ? scene.body_descriptions()[set.rigid].rigid_displacement(t0, t1)[k] : 0.0;
       const auto &d = scene.boundary_descriptions()[set.boundary];
       const auto &x = network.cells[c].nucleus;
       if (k < 2 && (d.velocity || d.displacement))
@@ -658,10 +658,10 @@ namespace hysteron
     {
       const unsigned int k = dof % 3;
       if (set.rigid >= 0)
-        return k < 2 ? evaluate_in_time<2>(*scene.body_descriptions()[set.rigid].rigid_velocity, t)[k] : 0.0;
+        return k < 2 ? scene.body_descriptions()[set.rigid].rigid_velocity_at(t)[k] : 0.0;
       const auto &d = scene.boundary_descriptions()[set.boundary];
       if (d.velocity)
-        return k < 2 ? evaluate_in_time<2>(*d.velocity, t)[k] : 0.0;
+        return k < 2 ? d.velocity_at(t)[k] : 0.0;
       if (!d.displacement)
         return 0; // fixed, roller
       // g'(t) = (g(t + h) - g(t - h)) / 2h, error O(h^2).

@@ -630,6 +630,12 @@ namespace hysteron
       if (nominal == 0)
         nominal = time.end_time / n_increments;
       increments = IncrementControl(nominal, newton.max_cuts);
+      if (analysis != Analysis::variable_order && !time.steps.empty())
+        {
+          std::vector<double> ends, nominals;
+          time.step_grid(ends, nominals);
+          increments.set_steps(ends, nominals);
+        }
     }
 
 

@@ -17,6 +17,7 @@ namespace hysteron
     names.bodies     = parse_names(prm.get("Body names"), "Body names");
     names.boundaries = parse_names(prm.get("Boundary names"), "Boundary names");
     names.loads      = parse_names(prm.get("Load names"), "Load names");
+    names.amplitudes = parse_names(prm.get("Amplitude names"), "Amplitude names");
     return names;
   }
 
@@ -46,12 +47,52 @@ namespace hysteron
 
   template <int dim>
   dealii::Tensor<1, dim>
-  integrate_in_time(const dealii::FunctionParser<1> &f, const double t0, const double t1)
+  integrate_in_time(const dealii::FunctionParser<1> &f,
+                    const double                     t0,
+                    const double                     t1,
+                    const Amplitude                 *amplitude)
   {
-    const double m = 0.5 * (t0 + t1), r = 0.5 * (t1 - t0), a = std::sqrt(0.6);
-    return r * ((5.0 / 9.0) * evaluate_in_time<dim>(f, m - a * r) +
-                (8.0 / 9.0) * evaluate_in_time<dim>(f, m) +
-                (5.0 / 9.0) * evaluate_in_time<dim>(f, m + a * r));
+    // f(t) a(t) on [s0, s1], 3-point Gauss-Legendre.
+    const auto piece = [&](const double s0, const double s1) {
+      const double           m = 0.5 * (s0 + s1), r = 0.5 * (s1 - s0), g = std::sqrt(0.6);
+      dealii::Tensor<1, dim> sum;
+      for (const auto &[x, w] : {std::make_pair(m - g * r, 5.0 / 9.0),
+                                 std::make_pair(m, 8.0 / 9.0),
+                                 std::make_pair(m + g * r, 5.0 / 9.0)})
+        sum += (w * (amplitude ? amplitude->value(x) : 1.0)) * evaluate_in_time<dim>(f, x);
+      return r * sum;
+    };
+    if (!amplitude)
+      return piece(t0, t1);
+    dealii::Tensor<1, dim> sum;
+    double                 s0 = t0;
+    for (const double s1 : amplitude->breakpoints(t0, t1))
+      {
+        sum += piece(s0, s1);
+        s0 = s1;
+      }
+    return sum + piece(s0, t1);
+  }
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  BodyDescription<dim>::rigid_velocity_at(const double t) const
+  {
+    return evaluate_in_time<dim>(*rigid_velocity, t) * (amplitude ? amplitude->value(t) : 1.0);
+  }
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  BodyDescription<dim>::rigid_displacement(const double t0, const double t1) const
+  {
+    return integrate_in_time<dim>(*rigid_velocity, t0, t1, amplitude.get());
+  }
+
+  template <int dim>
+  dealii::Tensor<1, dim>
+  BoundaryDescription<dim>::velocity_at(const double t) const
+  {
+    return evaluate_in_time<dim>(*velocity, t) * (amplitude ? amplitude->value(t) : 1.0);
   }
 
 
@@ -121,14 +162,17 @@ namespace hysteron
                                                    const dealii::Point<dim> &x) const
   {
     if (!displacement)
-      return integrate_in_time<dim>(*velocity, t0, t1);
+      return integrate_in_time<dim>(*velocity, t0, t1, amplitude.get());
+    // u(x, t1) a(t1) - u(x, t0) a(t0).
+    const double           a1 = amplitude ? amplitude->value(t1) : 1.0;
+    const double           a0 = amplitude ? amplitude->value(t0) : 1.0;
     dealii::Tensor<1, dim> u;
     displacement->set_time(t1);
     for (unsigned int d = 0; d < dim; ++d)
-      u[d] = displacement->value(x, d);
+      u[d] = a1 * displacement->value(x, d);
     displacement->set_time(t0);
     for (unsigned int d = 0; d < dim; ++d)
-      u[d] -= displacement->value(x, d);
+      u[d] -= a0 * displacement->value(x, d);
     return u;
   }
 
@@ -141,7 +185,7 @@ namespace hysteron
                                           const dealii::Point<dim> &x) const
   {
     if (velocity)
-      return evaluate_in_time<dim>(*velocity, t);
+      return velocity_at(t);
     Assert(dt > 0, dealii::ExcMessage("a displacement needs the step length"));
     return displacement_increment(std::max(t - dt, 0.0), t, x) / dt;
   }
@@ -152,7 +196,7 @@ namespace hysteron
   dealii::Tensor<1, dim>
   LoadDescription<dim>::value_at(const double t) const
   {
-    return evaluate_in_time<dim>(*value, t);
+    return evaluate_in_time<dim>(*value, t) * (amplitude ? amplitude->value(t) : 1.0);
   }
 
   template <int dim>
@@ -229,6 +273,11 @@ namespace hysteron
                           Patterns::Anything(),
                           "Rigid bodies: velocity [m/s] as functions of t, components separated "
                           "by ';', e.g. '0.01; 0' or '0.01*sin(2*pi*t); 0'.");
+        prm.declare_entry("Amplitude",
+                          "",
+                          Patterns::Anything(),
+                          "Rigid bodies: the name of an amplitude (`Amplitude names`) a(t) that "
+                          "multiplies `Velocity`; empty: none.");
         prm.leave_subsection();
       }
     for (const auto &name : names.boundaries)
@@ -269,6 +318,12 @@ namespace hysteron
                           "displacement type: the displacement [m] as functions of x, y (, z) and "
                           "t, one per space direction separated by ';' (entries of free components "
                           "are unused); a node at x moves by u(x, t) - u(x, 0).");
+        prm.declare_entry("Amplitude",
+                          "",
+                          Patterns::Anything(),
+                          "velocity and displacement types: the name of an amplitude (`Amplitude "
+                          "names`) a(t) that multiplies `Velocity` or `Displacement` (a node then "
+                          "moves by u(x, t) a(t) - u(x, 0) a(0)); empty: none.");
         prm.leave_subsection();
       }
     for (const auto &name : names.loads)
@@ -290,13 +345,18 @@ namespace hysteron
                           Patterns::Anything(),
                           "The load as functions of t, one component per space direction "
                           "separated by ';', e.g. '0; -60e3*t/20'. Required.");
+        prm.declare_entry("Amplitude",
+                          "",
+                          Patterns::Anything(),
+                          "The name of an amplitude (`Amplitude names`) a(t) that multiplies "
+                          "`Value`, e.g. a cyclic history '0; -60e3' times a table; empty: none.");
         prm.leave_subsection();
       }
   }
 
   template <int dim>
   std::vector<BodyDescription<dim>>
-  parse_bodies(dealii::ParameterHandler &prm, const SceneNames &names)
+  parse_bodies(dealii::ParameterHandler &prm, const SceneNames &names, const AmplitudeMap &amplitudes)
   {
     std::vector<BodyDescription<dim>> bodies;
     for (const auto &name : names.bodies)
@@ -333,13 +393,21 @@ namespace hysteron
                                                           s.where("Initial velocity"));
         b.rigid = s.get_bool("Rigid");
         if (b.rigid)
-          b.rigid_velocity =
-            parse_vector_function<1>(s.get("Velocity"), dim, "t", false, s.where("Velocity"));
+          {
+            b.rigid_velocity =
+              parse_vector_function<1>(s.get("Velocity"), dim, "t", false, s.where("Velocity"));
+            b.amplitude = find_amplitude(s, "Amplitude", amplitudes);
+          }
         else
-          require(dealii::Utilities::trim(s.get("Velocity")).empty(),
-                  s.where("Velocity"),
-                  "only rigid bodies have a prescribed velocity (set Rigid = true, or use "
-                  "`Initial velocity`)");
+          {
+            require(dealii::Utilities::trim(s.get("Velocity")).empty(),
+                    s.where("Velocity"),
+                    "only rigid bodies have a prescribed velocity (set Rigid = true, or use "
+                    "`Initial velocity`)");
+            require(dealii::Utilities::trim(s.get("Amplitude")).empty(),
+                    s.where("Amplitude"),
+                    "an amplitude multiplies the `Velocity` of a rigid body; this body is not rigid");
+          }
         bodies.push_back(std::move(b));
       }
     return bodies;
@@ -347,7 +415,7 @@ namespace hysteron
 
   template <int dim>
   std::vector<BoundaryDescription<dim>>
-  parse_boundaries(dealii::ParameterHandler &prm, const SceneNames &names)
+  parse_boundaries(dealii::ParameterHandler &prm, const SceneNames &names, const AmplitudeMap &amplitudes)
   {
     using Description = BoundaryDescription<dim>;
     std::vector<Description> boundaries;
@@ -415,7 +483,13 @@ namespace hysteron
                                                           space_variables<dim>() + ",t",
                                                           true,
                                                           s.where("Displacement"));
+            b.amplitude = find_amplitude(s, "Amplitude", amplitudes);
           }
+        else
+          require(dealii::Utilities::trim(s.get("Amplitude")).empty(),
+                  s.where("Amplitude"),
+                  "an amplitude multiplies a `Velocity` or a `Displacement`; a " + type +
+                    " condition has neither");
         boundaries.push_back(std::move(b));
       }
     return boundaries;
@@ -423,7 +497,7 @@ namespace hysteron
 
   template <int dim>
   std::vector<LoadDescription<dim>>
-  parse_loads(dealii::ParameterHandler &prm, const SceneNames &names)
+  parse_loads(dealii::ParameterHandler &prm, const SceneNames &names, const AmplitudeMap &amplitudes)
   {
     std::vector<LoadDescription<dim>> loads;
     for (const auto &name : names.loads)
@@ -437,7 +511,8 @@ namespace hysteron
                 s.where("Region"),
                 "a load needs the region of the points it acts on");
         l.region = Geometry::Region<dim>::parse(s.get("Region"), s.where("Region"));
-        l.value  = parse_vector_function<1>(s.get("Value"), dim, "t", false, s.where("Value"));
+        l.value     = parse_vector_function<1>(s.get("Value"), dim, "t", false, s.where("Value"));
+        l.amplitude = find_amplitude(s, "Amplitude", amplitudes);
         loads.push_back(std::move(l));
       }
     return loads;
@@ -448,17 +523,20 @@ namespace hysteron
   template struct BoundaryDescription<dim>;                                                     \
   template struct LoadDescription<dim>;                                                         \
   template std::vector<BodyDescription<dim>> parse_bodies<dim>(dealii::ParameterHandler &,      \
-                                                               const SceneNames &);             \
+                                                               const SceneNames &,              \
+                                                               const AmplitudeMap &);           \
   template std::vector<BoundaryDescription<dim>> parse_boundaries<dim>(                         \
-    dealii::ParameterHandler &, const SceneNames &);                                            \
+    dealii::ParameterHandler &, const SceneNames &, const AmplitudeMap &);                      \
   template std::vector<LoadDescription<dim>> parse_loads<dim>(dealii::ParameterHandler &,       \
-                                                              const SceneNames &);              \
+                                                              const SceneNames &,               \
+                                                              const AmplitudeMap &);            \
   template dealii::Tensor<1, dim> parse_vector<dim>(const std::string &, const std::string &);  \
   template dealii::Tensor<1, dim> evaluate_in_time<dim>(const dealii::FunctionParser<1> &,      \
                                                         double);                               \
   template dealii::Tensor<1, dim> integrate_in_time<dim>(const dealii::FunctionParser<1> &,     \
                                                          double,                               \
-                                                         double);
+                                                         double,                               \
+                                                         const Amplitude *);
 
   HYSTERON_INSTANTIATE(2)
   HYSTERON_INSTANTIATE(3)

@@ -6,6 +6,7 @@
 #include <hysteron/scene/output_column.h>
 #include <hysteron/scene/scene.h>
 
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -46,6 +47,12 @@ namespace hysteron
                       Patterns::List(Patterns::Anything()),
                       "Names of the loads (forces, tractions); each name N gets `subsection Load "
                       "N`.");
+    prm.declare_entry("Amplitude names",
+                      "",
+                      Patterns::List(Patterns::Anything()),
+                      "Names of the amplitudes: tables of a(t) that multiply the loads, "
+                      "boundary conditions and rigid-body velocities that name them in their "
+                      "`Amplitude` entry; each name N gets `subsection Amplitude N`.");
     prm.declare_entry("Additional shared libraries",
                       "",
                       Patterns::List(Patterns::FileName()),
@@ -89,6 +96,17 @@ namespace hysteron
                         "0.5",
                         Patterns::Double(),
                         "Fraction of the critical time step used by automatic stepping, in (0, 1].");
+      prm.declare_entry("Steps",
+                        "",
+                        Patterns::Anything(),
+                        "Load steps of the implicit analyses (FEM quasi-static and implicit "
+                        "dynamics; RBSN static, quasi-static and implicit dynamics) as 'end time: "
+                        "increments' separated by ';', e.g. '1: 20; 1.5: 1; 3: 40' (load, hold, "
+                        "unload with the histories of doc/amplitudes.md): each step has its own "
+                        "increment (end - start) / increments and no increment crosses its end. "
+                        "The last end time is `End time`. Empty: one step with the method's "
+                        "`Number of increments` or `Time step`, which the steps replace. The MPM, "
+                        "explicit and variable-order analyses take their own steps.");
     }
     prm.leave_subsection();
 
@@ -173,6 +191,7 @@ namespace hysteron
       }
 
     declare_scene_descriptions(prm, names);
+    Amplitude::declare_parameters(prm, names.amplitudes);
     Methods::Registry<3>::declare_parameters(prm);
   }
 
@@ -211,6 +230,43 @@ namespace hysteron
       require(time.cfl_factor <= 1.0,
               s.where("CFL factor"),
               "must be <= 1 (got " + s.get("CFL factor") + ")");
+      double previous = 0;
+      for (const auto &item : dealii::Utilities::split_string_list(s.get("Steps"), ';'))
+        {
+          const auto parts = dealii::Utilities::split_string_list(item, ':');
+          double     end   = 0;
+          long       n     = 0;
+          bool       ok    = parts.size() == 2;
+          try
+            {
+              if (ok)
+                {
+                  end = dealii::Utilities::string_to_double(parts[0]);
+                  n   = dealii::Utilities::string_to_int(parts[1]);
+                }
+            }
+          catch (...)
+            {
+              ok = false;
+            }
+          require(ok && std::isfinite(end),
+                  s.where("Steps"),
+                  "'" + item + "' is not 'end time: increments', e.g. '1.5: 10'");
+          require(end > previous,
+                  s.where("Steps"),
+                  "the step '" + item + "' does not end after the previous one (at " +
+                    std::to_string(previous) + " s): the end times must increase");
+          require(n >= 1 && n <= 10000000L,
+                  s.where("Steps"),
+                  "the step '" + item + "' needs 1 to 10,000,000 increments");
+          time.steps.emplace_back(end, static_cast<unsigned int>(n));
+          previous = end;
+        }
+      if (!time.steps.empty())
+        require(std::abs(previous - time.end_time) <= 1e-12 * time.end_time,
+                s.where("Steps"),
+                "the last step ends at " + std::to_string(previous) + " s, but `End time` is " +
+                  std::to_string(time.end_time) + " s: they must agree");
     }
     {
       Section s(prm, {"Output"});
@@ -250,12 +306,15 @@ namespace hysteron
       }
 
     gravity_vector = parse_vector<dim>(prm.get("Gravity"), "Gravity");
-    bodies         = parse_bodies<dim>(prm, scene_names);
+    const AmplitudeMap amplitudes = Amplitude::parse_all(prm, scene_names.amplitudes, [this](const std::string &f) {
+      return resolve_input_file(f);
+    });
+    bodies         = parse_bodies<dim>(prm, scene_names, amplitudes);
     for (const auto &b : bodies)
       material(b.material, "Body " + b.name + "/Material");
     check_axisymmetry();
-    boundaries = parse_boundaries<dim>(prm, scene_names);
-    loads      = parse_loads<dim>(prm, scene_names);
+    boundaries = parse_boundaries<dim>(prm, scene_names, amplitudes);
+    loads      = parse_loads<dim>(prm, scene_names, amplitudes);
     // Expressions of time only: NaN or infinity anywhere in [0, End time] is bad input.
     for (const auto &b : bodies)
       if (b.rigid_velocity)

@@ -196,7 +196,9 @@ namespace hysteron
    * The increments of an implicit run: the nominal step, halved after each
    * failed increment (at most `Maximum increment cuts` times in a row), doubled
    * back after two good ones. Times that land on the nominal grid are snapped
-   * to it (no drift of the sum of the steps).
+   * to it (no drift of the sum of the steps). With a sequence of load steps
+   * (`Time/Steps`), each step has its own nominal increment and grid, and no
+   * increment crosses the end of a step.
    */
   class IncrementControl
   {
@@ -206,11 +208,25 @@ namespace hysteron
       , max_cuts(max_cuts)
     {}
 
-    /// The step from @p t, not beyond @p end.
+    /// Load steps: step k ends at @p ends[k] (increasing) with the nominal increment
+    /// @p nominals[k]; after the last, the last nominal increment.
+    void
+    set_steps(const std::vector<double> &ends, const std::vector<double> &nominals)
+    {
+      step_ends     = ends;
+      step_nominals = nominals;
+      if (!nominals.empty())
+        nominal_step = nominals.front();
+    }
+
+    /// The step from @p t, not beyond @p end (nor beyond the end of the load step of @p t).
     double
     step(const double t, const double end) const
     {
-      return std::min(nominal_step / std::pow(2.0, level), end - t);
+      const unsigned int k = load_step(t);
+      if (k == step_ends.size())
+        return std::min(nominal_step / std::pow(2.0, level), end - t);
+      return std::min(step_nominals[k] / std::pow(2.0, level), std::min(end, step_ends[k]) - t);
     }
 
     /// After a failed increment: halve; false when the cuts are used up.
@@ -226,8 +242,18 @@ namespace hysteron
     void
     accept(double &t, const double dt)
     {
+      const unsigned int s = load_step(t);
       t += dt;
-      if (const double k = std::round(t / nominal_step); std::abs(t - k * nominal_step) < 1e-9 * nominal_step)
+      if (s < step_ends.size())
+        {
+          // The grid of load step s starts at the end of the previous one.
+          const double start = s > 0 ? step_ends[s - 1] : 0.0, h = step_nominals[s];
+          if (const double k = std::round((t - start) / h); std::abs(t - (start + k * h)) < 1e-9 * h)
+            t = start + k * h;
+          if (std::abs(t - step_ends[s]) < 1e-9 * h)
+            t = step_ends[s];
+        }
+      else if (const double k = std::round(t / nominal_step); std::abs(t - k * nominal_step) < 1e-9 * nominal_step)
         t = k * nominal_step;
       if (level > 0 && ++successes >= 2)
         {
@@ -265,9 +291,20 @@ namespace hysteron
     }
 
   private:
-    double       nominal_step;
-    unsigned int max_cuts;
-    unsigned int level = 0, successes = 0, n_cuts = 0;
+    /// The load step that holds @p t (the first whose end is after it); size() if none.
+    unsigned int
+    load_step(const double t) const
+    {
+      unsigned int k = 0;
+      while (k < step_ends.size() && !(t < step_ends[k] - 1e-9 * step_nominals[k]))
+        ++k;
+      return k;
+    }
+
+    double              nominal_step;
+    unsigned int        max_cuts;
+    unsigned int        level = 0, successes = 0, n_cuts = 0;
+    std::vector<double> step_ends, step_nominals;
   };
 } // namespace hysteron
 

@@ -8,7 +8,9 @@
 
 #include <hysteron/base/parameters.h>
 #include <hysteron/geometry/region.h>
+#include <hysteron/scene/amplitude.h>
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -17,8 +19,9 @@ namespace hysteron
 {
   /**
    * The names of the named subsections of a scene, read in the pre-pass:
-   * `Material names`, `Body names`, `Boundary names`, `Load names`. Each name N
-   * gets `subsection Material N` (resp. `Body N`, `Boundary N`, `Load N`).
+   * `Material names`, `Body names`, `Boundary names`, `Load names`, `Amplitude names`.
+   * Each name N gets `subsection Material N` (resp. `Body N`, `Boundary N`, `Load N`,
+   * `Amplitude N`).
    */
   struct SceneNames
   {
@@ -26,8 +29,9 @@ namespace hysteron
     std::vector<std::string> bodies;
     std::vector<std::string> boundaries;
     std::vector<std::string> loads;
+    std::vector<std::string> amplitudes;
 
-    /// Read the four lists (declared by declare_preamble()) from @p prm.
+    /// Read the five lists (declared by declare_preamble()) from @p prm.
     static SceneNames
     read(const dealii::ParameterHandler &prm);
   };
@@ -53,6 +57,15 @@ namespace hysteron
     std::shared_ptr<dealii::FunctionParser<dim>>  initial_velocity; ///< of x; null: at rest
     bool                                          rigid = false;
     std::shared_ptr<dealii::FunctionParser<1>>    rigid_velocity; ///< of t (rigid bodies)
+    std::shared_ptr<const Amplitude>              amplitude; ///< multiplies rigid_velocity; null: 1
+
+    /// A rigid body's velocity at @p t (`Velocity` times the amplitude).
+    dealii::Tensor<1, dim>
+    rigid_velocity_at(const double t) const;
+
+    /// A rigid body's displacement from @p t0 to @p t1.
+    dealii::Tensor<1, dim>
+    rigid_displacement(const double t0, const double t1) const;
 
     dealii::Tensor<1, dim>
     velocity_at(const dealii::Point<dim> &p) const;
@@ -95,6 +108,12 @@ namespace hysteron
     std::shared_ptr<dealii::FunctionParser<1>> velocity;     ///< velocity type: of t
     /// displacement type: of x, y (, z), t; u(x, t) - u(x, 0) is prescribed
     std::shared_ptr<dealii::FunctionParser<dim>> displacement;
+    /// Multiplies the velocity or the displacement (u(x, t) a(t)); null: 1.
+    std::shared_ptr<const Amplitude> amplitude;
+
+    /// velocity type: the velocity at @p t (times the amplitude).
+    dealii::Tensor<1, dim>
+    velocity_at(const double t) const;
 
     /**
      * velocity and displacement types, for explicit steps: the velocity v(t)
@@ -147,7 +166,9 @@ namespace hysteron
     Type                                       type = Type::force;
     Geometry::Region<dim>                      region;
     std::shared_ptr<dealii::FunctionParser<1>> value; ///< of t, dim components
+    std::shared_ptr<const Amplitude>           amplitude; ///< multiplies value; null: 1
 
+    /// `Value` at @p t times the amplitude.
     dealii::Tensor<1, dim>
     value_at(const double t) const;
   };
@@ -156,17 +177,20 @@ namespace hysteron
   void
   declare_scene_descriptions(dealii::ParameterHandler &prm, const SceneNames &names);
 
+  /// The scene's amplitudes by name (Amplitude::parse_all()).
+  using AmplitudeMap = std::map<std::string, std::shared_ptr<const Amplitude>>;
+
   template <int dim>
   std::vector<BodyDescription<dim>>
-  parse_bodies(dealii::ParameterHandler &prm, const SceneNames &names);
+  parse_bodies(dealii::ParameterHandler &prm, const SceneNames &names, const AmplitudeMap &amplitudes);
 
   template <int dim>
   std::vector<BoundaryDescription<dim>>
-  parse_boundaries(dealii::ParameterHandler &prm, const SceneNames &names);
+  parse_boundaries(dealii::ParameterHandler &prm, const SceneNames &names, const AmplitudeMap &amplitudes);
 
   template <int dim>
   std::vector<LoadDescription<dim>>
-  parse_loads(dealii::ParameterHandler &prm, const SceneNames &names);
+  parse_loads(dealii::ParameterHandler &prm, const SceneNames &names, const AmplitudeMap &amplitudes);
 
   /// `Gravity` (top level): a vector of dim components [m/s^2]; "" is zero.
   template <int dim>
@@ -178,11 +202,16 @@ namespace hysteron
   dealii::Tensor<1, dim>
   evaluate_in_time(const dealii::FunctionParser<1> &f, const double t);
 
-  /// The integral of a vector function of t over [t0, t1] by 3-point Gauss-Legendre
-  /// (exact for polynomials of degree 5; a velocity's displacement increment).
+  /// The integral of a vector function of t (times @p amplitude, if given) over [t0, t1] by
+  /// 3-point Gauss-Legendre on each piece between the amplitude's points (exact for
+  /// polynomials of degree 5 times a piecewise linear amplitude; a velocity's displacement
+  /// increment).
   template <int dim>
   dealii::Tensor<1, dim>
-  integrate_in_time(const dealii::FunctionParser<1> &f, const double t0, const double t1);
+  integrate_in_time(const dealii::FunctionParser<1> &f,
+                    const double                     t0,
+                    const double                     t1,
+                    const Amplitude                 *amplitude = nullptr);
 } // namespace hysteron
 
 #endif

@@ -25,6 +25,23 @@ namespace hysteron
     double end_time   = 1.0;
     double time_step  = 0.0; ///< 0: automatic from the CFL factor.
     double cfl_factor = 0.5;
+    /// `Steps`: the load steps (end time, number of increments); empty: one step.
+    std::vector<std::pair<double, unsigned int>> steps;
+
+    /// The end times and nominal increments of the load steps (for IncrementControl).
+    void
+    step_grid(std::vector<double> &ends, std::vector<double> &nominals) const
+    {
+      ends.clear();
+      nominals.clear();
+      double start = 0;
+      for (const auto &[end, n] : steps)
+        {
+          ends.push_back(end);
+          nominals.push_back((end - start) / n);
+          start = end;
+        }
+    }
 
     bool
     automatic_time_step() const
