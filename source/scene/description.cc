@@ -74,11 +74,22 @@ namespace hysteron
     return sum + piece(s0, t1);
   }
 
+  namespace
+  {
+    /// f(t) a(t) (a = 1 without an amplitude): every amplified history of t.
+    template <int dim>
+    dealii::Tensor<1, dim>
+    amplified(const dealii::FunctionParser<1> &f, const Amplitude *amplitude, const double t)
+    {
+      return evaluate_in_time<dim>(f, t) * (amplitude ? amplitude->value(t) : 1.0);
+    }
+  } // namespace
+
   template <int dim>
   dealii::Tensor<1, dim>
   BodyDescription<dim>::rigid_velocity_at(const double t) const
   {
-    return evaluate_in_time<dim>(*rigid_velocity, t) * (amplitude ? amplitude->value(t) : 1.0);
+    return amplified<dim>(*rigid_velocity, amplitude.get(), t);
   }
 
   template <int dim>
@@ -92,7 +103,7 @@ namespace hysteron
   dealii::Tensor<1, dim>
   BoundaryDescription<dim>::velocity_at(const double t) const
   {
-    return evaluate_in_time<dim>(*velocity, t) * (amplitude ? amplitude->value(t) : 1.0);
+    return amplified<dim>(*velocity, amplitude.get(), t);
   }
 
 
@@ -196,7 +207,7 @@ namespace hysteron
   dealii::Tensor<1, dim>
   LoadDescription<dim>::value_at(const double t) const
   {
-    return evaluate_in_time<dim>(*value, t) * (amplitude ? amplitude->value(t) : 1.0);
+    return amplified<dim>(*value, amplitude.get(), t);
   }
 
   template <int dim>
