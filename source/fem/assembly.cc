@@ -121,7 +121,7 @@ namespace hysteron
         for (unsigned int l = 0; l < n_loads; ++l)
           if (cell_in_load[first + l] && load_sets[l].kind == LoadSet::Kind::traction)
             for (const unsigned int face : cell->face_indices())
-              if (cell->face(face)->at_boundary() && in_region(l, cell->face(face)->center()))
+              if (loads_face(l, cell, face))
                 {
                   ffv.reinit(cell, face);
                   for (unsigned int q = 0; q < ffv.n_quadrature_points; ++q)

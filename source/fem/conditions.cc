@@ -92,12 +92,20 @@ namespace hysteron
               continue;
             }
           const auto [lower, upper] = mesh_box.get_boundary_points();
-          for (const auto &[dof, p] : support)
-            if (d.prescribes(p, component[dof], lower, upper, tolerance))
-              add(set, dof, component[dof], index);
+          if (!d.physical_group.empty())
+            {
+              // The nodes of a Gmsh group's faces or cells.
+              for (const auto &[dof, c] : group_dofs(physical_group(d.physical_group, "Boundary " + d.name + "/Set")))
+                if (d.type == Type::fixed || d.components[c])
+                  add(set, dof, c, index);
+            }
+          else
+            for (const auto &[dof, p] : support)
+              if (d.prescribes(p, component[dof], lower, upper, tolerance))
+                add(set, dof, component[dof], index);
           const unsigned long n = dealii::Utilities::MPI::sum<unsigned long>(set.dofs.size(), scene.mpi_communicator());
           require(n > 0,
-                  "Boundary " + d.name + (d.has_region ? "/Region" : "/Faces"),
+                  "Boundary " + d.name + (!d.set.empty() ? "/Set" : d.has_region ? "/Region" : "/Faces"),
                   "selects no node of the fem mesh (faces are those of the mesh's bounding "
                   "box; a region must contain mesh nodes)");
           dirichlet.push_back(std::move(set));
@@ -190,6 +198,19 @@ namespace hysteron
           LoadSet set;
           set.load = l;
           set.kind = loads[l].type == Type::traction ? LoadSet::Kind::traction : LoadSet::Kind::volume;
+          if (!loads[l].physical_group.empty())
+            {
+              // A group of faces carries a traction (a force: spread as a uniform one), a
+              // group of cells a force spread over their volume.
+              const std::string   where = "Load " + loads[l].name + "/Set";
+              const PhysicalGroup group = physical_group(loads[l].physical_group, where);
+              require(group.faces || loads[l].type == Type::force,
+                      where,
+                      "a traction acts on boundary faces, but the physical group '" +
+                        loads[l].physical_group + "' is a group of cells (use Type = force)");
+              set.group = group.tag;
+              set.kind  = group.faces ? LoadSet::Kind::traction : LoadSet::Kind::volume;
+            }
           load_sets.push_back(set);
           load_regions.push_back(&loads[l].region);
         }
@@ -204,8 +225,10 @@ namespace hysteron
             for (unsigned int l = 0; l < n_loads; ++l)
               if (load_sets[l].kind == LoadSet::Kind::volume)
                 {
+                  if (load_sets[l].group >= 0 && !in_cell_group(cell, load_sets[l].group))
+                    continue;
                   for (unsigned int q = 0; q < h.point.size(); ++q)
-                    if (load_regions[l]->contains(h.point[q], tolerance))
+                    if (in_region(l, h.point[q]))
                       {
                         selected[l] += h.weight[q];
                         cell_in_load[first + l] = true;
@@ -213,7 +236,7 @@ namespace hysteron
                 }
               else
                 for (const unsigned int f : cell->face_indices())
-                  if (cell->face(f)->at_boundary() && load_regions[l]->contains(cell->face(f)->center(), tolerance))
+                  if (loads_face(l, cell, f))
                     {
                       selected[l] += cell->face(f)->measure() *
                                      scene.thickness_at(scene.body_descriptions()[h.body], cell->face(f)->center());
@@ -227,13 +250,15 @@ namespace hysteron
           if (set.kind == LoadSet::Kind::traction)
             {
               require(selected[l] > 0,
-                      "Load " + loads[l].name + "/Region",
+                      "Load " + loads[l].name + (loads[l].set.empty() ? "/Region" : "/Set"),
                       "contains the centre of no boundary face of the fem mesh");
-              set.scale = 1.0;
+              // A force on a group of faces: the traction F / area.
+              set.scale = loads[l].type == Type::force ? 1.0 / selected[l] : 1.0;
               continue;
             }
-          if (selected[l] > 0)
+          if (selected[l] > 0 || set.group >= 0)
             {
+              require(selected[l] > 0, "Load " + loads[l].name + "/Set", "the group has no cell");
               set.scale = 1.0 / selected[l];
               continue;
             }

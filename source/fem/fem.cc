@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <limits>
+#include <iostream>
 #include <sstream>
 
 namespace hysteron
@@ -290,6 +291,7 @@ namespace hysteron
       check_supports();
       setup_loads();
       setup_probes();
+      setup_set_histories();
       setup_dynamics();
       const std::string analysis_name = analysis == Analysis::quasi_static      ? "quasi-static" :
                                         analysis == Analysis::implicit_dynamics ? "implicit dynamics" :
@@ -402,6 +404,10 @@ namespace hysteron
     {
       if (quadrature_table)
         write_quadrature_table();
+      // The load-displacement curves of the history sets (rank 0; a warning, never an error).
+      tables.flush();
+      for (const auto &warning : tables.draw_histories())
+        std::cerr << "hysteron: warning: " << warning << std::endl;
     }
 
 

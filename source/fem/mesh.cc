@@ -60,6 +60,7 @@ namespace hysteron
               e.print_info(m);
               throw InputError("FEM/Mesh/Mesh file", "cannot read '" + mesh_file + "': " + m.str());
             }
+          read_physical_groups(serial);
           for (const auto &cell : serial.active_cell_iterators())
             {
               require(cell->reference_cell() == dealii::ReferenceCells::get_hypercube<dim>(),
@@ -83,6 +84,7 @@ namespace hysteron
               cell->set_material_id(body);
             }
           triangulation.copy_triangulation(serial);
+          check_coarse_order(serial);
         }
       else
         {
@@ -186,8 +188,11 @@ namespace hysteron
               dealii::Point<dim> on_axis = lo;
               on_axis[1]                 = 0.5 * (lo[1] + hi[1]);
               bool held                  = false;
+              // A physical group's nodes are known after the DoFs: trust a group that prescribes u_r.
               for (const auto &b : scene.boundary_descriptions())
-                held = held || b.prescribes(on_axis, 0, lo, hi, tol);
+                held = held || b.prescribes(on_axis, 0, lo, hi, tol) ||
+                       (!b.physical_group.empty() &&
+                        (b.type == BoundaryDescription<dim>::Type::fixed || b.components[0]));
               require(held,
                       "Boundary names",
                       "the axisymmetric mesh reaches the axis x = 0 but no boundary condition "

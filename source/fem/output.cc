@@ -215,7 +215,7 @@ namespace hysteron
           kinetic += 0.5 * lumped_mass(i) * v(i) * v(i);
 
       tables.write(t, rows, averages, {{kinetic, strain_energy, internal_work, external_work, boundary_work}},
-                   reactions(), comm);
+                   reactions(), comm, set_history_values());
     }
 
 

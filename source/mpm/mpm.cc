@@ -210,6 +210,7 @@ namespace hysteron
               }
         }
       require(deformable, "Body names", "the mpm method needs at least one body that is not rigid");
+      scene.refuse_fem_only_sets("mpm");
 
       axisymmetric = scene.axisymmetric();
       if (axisymmetric)

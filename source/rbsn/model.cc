@@ -183,6 +183,7 @@ namespace hysteron
       , method(method)
       , direct(std::make_unique<SparseLU>())
     {
+      scene.refuse_fem_only_sets("rbsn");
       {
         Section s(prm, {"RBSN"});
         // A number is a constant d_m; anything else an expression in x and y,

@@ -18,6 +18,7 @@ namespace hysteron
     names.boundaries = parse_names(prm.get("Boundary names"), "Boundary names");
     names.loads      = parse_names(prm.get("Load names"), "Load names");
     names.amplitudes = parse_names(prm.get("Amplitude names"), "Amplitude names");
+    names.sets       = parse_names(prm.get("Set names"), "Set names");
     return names;
   }
 
@@ -31,6 +32,49 @@ namespace hysteron
     space_variables()
     {
       return dim == 2 ? "x,y" : "x,y,z";
+    }
+
+    /// The faces of the domain box listed in entry @p entry (`Faces`).
+    template <int dim>
+    std::vector<unsigned int>
+    parse_faces(const Section &s, const std::string &entry)
+    {
+      std::vector<unsigned int> faces;
+      for (const auto &f : s.get_list(entry))
+        {
+          bool found = false;
+          for (unsigned int face = 0; face < 2 * dim; ++face)
+            if (f == BoundaryDescription<dim>::face_name(face))
+              {
+                faces.push_back(face);
+                found = true;
+              }
+          require(found,
+                  s.where(entry),
+                  "unknown face '" + f + "' (a " + std::to_string(dim) + "D box has " +
+                    (dim == 2 ? "x-, x+, y-, y+" : "x-, x+, y-, y+, z-, z+") + ")");
+        }
+      return faces;
+    }
+
+    /// The set named in entry `Set` of @p s, or null if the entry is empty.
+    template <int dim>
+    const SetDescription<dim> *
+    find_set(const Section &s, const std::vector<SetDescription<dim>> &sets)
+    {
+      const std::string name = dealii::Utilities::trim(s.get("Set"));
+      if (name.empty())
+        return nullptr;
+      std::string known;
+      for (const auto &set : sets)
+        {
+          if (set.name == name)
+            return &set;
+          known += (known.empty() ? "" : ", ") + set.name;
+        }
+      throw InputError(s.where("Set"),
+                       "no set named '" + name + "' (`Set names` lists " +
+                         (known.empty() ? std::string("none") : known) + ")");
     }
   } // namespace
 
@@ -291,6 +335,29 @@ namespace hysteron
                           "multiplies `Velocity`; empty: none.");
         prm.leave_subsection();
       }
+    for (const auto &name : names.sets)
+      {
+        prm.enter_subsection("Set " + name);
+        prm.declare_entry("Faces",
+                          "",
+                          Patterns::Anything(),
+                          "Faces of the domain box (the grid's, the mesh's or the network's "
+                          "bounding box): a list of x-, x+, y-, y+, z-, z+.");
+        prm.declare_entry("Region",
+                          "",
+                          Patterns::Anything(),
+                          "And/or the nodes, points or cells inside this region [m]; see "
+                          "doc/geometry.md.");
+        prm.declare_entry("Physical group",
+                          "",
+                          Patterns::Anything(),
+                          "Or a physical group of the FEM's Gmsh mesh file, by name or number: a "
+                          "group of boundary lines (2D) or faces (3D) selects the nodes of its "
+                          "faces, a group of cells (surfaces in 2D, volumes in 3D) the nodes and "
+                          "quadrature points of its cells. The fem method with `Generator = "
+                          "file` only; not together with Faces or Region.");
+        prm.leave_subsection();
+      }
     for (const auto &name : names.boundaries)
       {
         prm.enter_subsection("Boundary " + name);
@@ -313,6 +380,11 @@ namespace hysteron
                           Patterns::Anything(),
                           "Alternatively (or additionally) the nodes inside this region [m] "
                           "(fixed, velocity and displacement types); see doc/geometry.md.");
+        prm.declare_entry("Set",
+                          "",
+                          Patterns::Anything(),
+                          "Or the name of a set (`Set names`) that gives the faces, the region or "
+                          "a Gmsh physical group; then Faces and Region stay empty.");
         prm.declare_entry("Components",
                           "all",
                           Patterns::Anything(),
@@ -350,7 +422,14 @@ namespace hysteron
                           "",
                           Patterns::Anything(),
                           "The region whose material points (at t = 0) carry the load [m]; "
-                          "see doc/geometry.md. Required.");
+                          "see doc/geometry.md. Required unless `Set` is given.");
+        prm.declare_entry("Set",
+                          "",
+                          Patterns::Anything(),
+                          "Or the name of a set (`Set names`) with a Region or a Gmsh physical "
+                          "group (the FEM loads its faces: traction, or a force spread as a "
+                          "uniform traction; or its cells: a force spread over their volume); "
+                          "then Region stays empty.");
         prm.declare_entry("Value",
                           "",
                           Patterns::Anything(),
@@ -425,8 +504,37 @@ namespace hysteron
   }
 
   template <int dim>
+  std::vector<SetDescription<dim>>
+  parse_sets(dealii::ParameterHandler &prm, const SceneNames &names)
+  {
+    std::vector<SetDescription<dim>> sets;
+    for (const auto &name : names.sets)
+      {
+        Section             s(prm, {"Set " + name});
+        SetDescription<dim> set;
+        set.name       = name;
+        set.faces      = parse_faces<dim>(s, "Faces");
+        set.has_region = !dealii::Utilities::trim(s.get("Region")).empty();
+        if (set.has_region)
+          set.region = Geometry::Region<dim>::parse(s.get("Region"), s.where("Region"));
+        set.physical_group = dealii::Utilities::trim(s.get("Physical group"));
+        require(set.physical_group.empty() || (set.faces.empty() && !set.has_region),
+                s.where("Physical group"),
+                "a set is a Gmsh physical group or faces and a region, not both");
+        require(!set.physical_group.empty() || !set.faces.empty() || set.has_region,
+                s.where("Region"),
+                "the set is empty: give `Faces`, a `Region` or a `Physical group`");
+        sets.push_back(std::move(set));
+      }
+    return sets;
+  }
+
+  template <int dim>
   std::vector<BoundaryDescription<dim>>
-  parse_boundaries(dealii::ParameterHandler &prm, const SceneNames &names, const AmplitudeMap &amplitudes)
+  parse_boundaries(dealii::ParameterHandler               &prm,
+                   const SceneNames                       &names,
+                   const AmplitudeMap                     &amplitudes,
+                   const std::vector<SetDescription<dim>> &sets)
   {
     using Description = BoundaryDescription<dim>;
     std::vector<Description> boundaries;
@@ -441,31 +549,29 @@ namespace hysteron
                                  type == "wall"     ? Description::Type::wall :
                                  type == "velocity" ? Description::Type::velocity :
                                                       Description::Type::displacement;
-        for (const auto &f : s.get_list("Faces"))
-          {
-            bool found = false;
-            for (unsigned int face = 0; face < 2 * dim; ++face)
-              if (f == Description::face_name(face))
-                {
-                  b.faces.push_back(face);
-                  found = true;
-                }
-            require(found,
-                    s.where("Faces"),
-                    "unknown face '" + f + "' (a " + std::to_string(dim) + "D box has " +
-                      (dim == 2 ? "x-, x+, y-, y+" : "x-, x+, y-, y+, z-, z+") + ")");
-          }
+        b.faces      = parse_faces<dim>(s, "Faces");
         b.has_region = !dealii::Utilities::trim(s.get("Region")).empty();
         if (b.has_region)
           b.region = Geometry::Region<dim>::parse(s.get("Region"), s.where("Region"));
-        require(!b.faces.empty() || b.has_region,
+        if (const auto *set = find_set<dim>(s, sets))
+          {
+            require(b.faces.empty() && !b.has_region,
+                    s.where("Set"),
+                    "give either a `Set` or `Faces`/`Region`, not both");
+            b.set            = set->name;
+            b.faces          = set->faces;
+            b.region         = set->region;
+            b.has_region     = set->has_region;
+            b.physical_group = set->physical_group;
+          }
+        require(!b.faces.empty() || b.has_region || !b.physical_group.empty(),
                 s.where("Faces"),
-                "a boundary condition needs `Faces` or a `Region`");
+                "a boundary condition needs `Faces`, a `Region` or a `Set`");
         if (b.type == Description::Type::roller || b.type == Description::Type::wall)
           require(!b.has_region && !b.faces.empty(),
-                  s.where("Region"),
+                  s.where(b.set.empty() ? "Region" : "Set"),
                   "roller and wall conditions act on `Faces` (the face gives the normal), "
-                  "not on a region");
+                  "not on a region or a physical group");
         b.components.assign(dim, true);
         if (b.type == Description::Type::velocity || b.type == Description::Type::displacement)
           {
@@ -508,7 +614,10 @@ namespace hysteron
 
   template <int dim>
   std::vector<LoadDescription<dim>>
-  parse_loads(dealii::ParameterHandler &prm, const SceneNames &names, const AmplitudeMap &amplitudes)
+  parse_loads(dealii::ParameterHandler               &prm,
+              const SceneNames                       &names,
+              const AmplitudeMap                     &amplitudes,
+              const std::vector<SetDescription<dim>> &sets)
   {
     std::vector<LoadDescription<dim>> loads;
     for (const auto &name : names.loads)
@@ -518,10 +627,23 @@ namespace hysteron
         l.name = name;
         l.type = s.get("Type") == "force" ? LoadDescription<dim>::Type::force :
                                             LoadDescription<dim>::Type::traction;
-        require(!dealii::Utilities::trim(s.get("Region")).empty(),
-                s.where("Region"),
-                "a load needs the region of the points it acts on");
-        l.region = Geometry::Region<dim>::parse(s.get("Region"), s.where("Region"));
+        const bool has_region = !dealii::Utilities::trim(s.get("Region")).empty();
+        if (const auto *set = find_set<dim>(s, sets))
+          {
+            require(!has_region, s.where("Set"), "give either a `Set` or a `Region`, not both");
+            require(set->has_region || !set->physical_group.empty(),
+                    s.where("Set"),
+                    "set '" + set->name +
+                      "' has only box faces; a load needs a set with a Region or a physical group");
+            l.set            = set->name;
+            l.region         = set->region;
+            l.physical_group = set->physical_group;
+          }
+        else
+          {
+            require(has_region, s.where("Region"), "a load needs the region of the points it acts on (or a `Set`)");
+            l.region = Geometry::Region<dim>::parse(s.get("Region"), s.where("Region"));
+          }
         l.value     = parse_vector_function<1>(s.get("Value"), dim, "t", false, s.where("Value"));
         l.amplitude = find_amplitude(s, "Amplitude", amplitudes);
         loads.push_back(std::move(l));
@@ -533,14 +655,17 @@ namespace hysteron
   template struct BodyDescription<dim>;                                                         \
   template struct BoundaryDescription<dim>;                                                     \
   template struct LoadDescription<dim>;                                                         \
+  template std::vector<SetDescription<dim>> parse_sets<dim>(dealii::ParameterHandler &,         \
+                                                            const SceneNames &);                \
   template std::vector<BodyDescription<dim>> parse_bodies<dim>(dealii::ParameterHandler &,      \
                                                                const SceneNames &,              \
                                                                const AmplitudeMap &);           \
   template std::vector<BoundaryDescription<dim>> parse_boundaries<dim>(                         \
-    dealii::ParameterHandler &, const SceneNames &, const AmplitudeMap &);                      \
-  template std::vector<LoadDescription<dim>> parse_loads<dim>(dealii::ParameterHandler &,       \
-                                                              const SceneNames &,               \
-                                                              const AmplitudeMap &);            \
+    dealii::ParameterHandler &, const SceneNames &, const AmplitudeMap &,                       \
+    const std::vector<SetDescription<dim>> &);                                                  \
+  template std::vector<LoadDescription<dim>> parse_loads<dim>(                                  \
+    dealii::ParameterHandler &, const SceneNames &, const AmplitudeMap &,                       \
+    const std::vector<SetDescription<dim>> &);                                                  \
   template dealii::Tensor<1, dim> parse_vector<dim>(const std::string &, const std::string &);  \
   template dealii::Tensor<1, dim> evaluate_in_time<dim>(const dealii::FunctionParser<1> &,      \
                                                         double);                               \

@@ -6,6 +6,7 @@
 #include <hysteron/scene/output_column.h>
 #include <hysteron/scene/scene.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -53,6 +54,12 @@ namespace hysteron
                       "Names of the amplitudes: tables of a(t) that multiply the loads, "
                       "boundary conditions and rigid-body velocities that name them in their "
                       "`Amplitude` entry; each name N gets `subsection Amplitude N`.");
+    prm.declare_entry("Set names",
+                      "",
+                      Patterns::List(Patterns::Anything()),
+                      "Names of node, point and cell sets (box faces, regions or Gmsh physical "
+                      "groups) that boundaries and loads name in their `Set` entry and "
+                      "`Output/History sets` writes; each name N gets `subsection Set N`.");
     prm.declare_entry("Additional shared libraries",
                       "",
                       Patterns::List(Patterns::FileName()),
@@ -153,6 +160,15 @@ namespace hysteron
                         "(MPM: the points that started in the region; FEM: the quadrature points "
                         "in it), e.g. a body's mean velocity or a section's mean stress, every "
                         "`Probe interval` (field methods).");
+      prm.declare_entry("History sets",
+                        "",
+                        Patterns::Anything(),
+                        "fem method: names of sets (`Set names`) whose history is written every "
+                        "`Probe interval` to history_<name>.csv: the mean displacement of the "
+                        "set's nodes, the reaction on them (the force of the supports, as in "
+                        "reactions.csv) and the external load on them, side by side (the "
+                        "load-displacement curve), drawn at the end of the run in "
+                        "history_<name>.png when gnuplot is installed.");
       prm.declare_entry("Progress interval",
                         "2",
                         Patterns::Double(),
@@ -313,8 +329,32 @@ namespace hysteron
     for (const auto &b : bodies)
       material(b.material, "Body " + b.name + "/Material");
     check_axisymmetry();
-    boundaries = parse_boundaries<dim>(prm, scene_names, amplitudes);
-    loads      = parse_loads<dim>(prm, scene_names, amplitudes);
+    sets       = parse_sets<dim>(prm, scene_names);
+    boundaries = parse_boundaries<dim>(prm, scene_names, amplitudes, sets);
+    loads      = parse_loads<dim>(prm, scene_names, amplitudes, sets);
+    {
+      Section s(prm, {"Output"});
+      for (const auto &name : s.get_list("History sets"))
+        {
+          unsigned int k = 0;
+          while (k < sets.size() && sets[k].name != name)
+            ++k;
+          require(k < sets.size(),
+                  s.where("History sets"),
+                  "no set named '" + name + "' (define it in `Set names` and `subsection Set " +
+                    name + "`)");
+          require(name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") ==
+                      std::string::npos,
+                  s.where("History sets"),
+                  "the set name '" + name + "' names the file history_" + name +
+                    ".csv: use letters, digits, '_', '.' and '-' only");
+          require(std::find(output.history_sets.begin(), output.history_sets.end(), k) ==
+                    output.history_sets.end(),
+                  s.where("History sets"),
+                  "the set '" + name + "' is listed twice");
+          output.history_sets.push_back(k);
+        }
+    }
     // Expressions of time only: NaN or infinity anywhere in [0, End time] is bad input.
     for (const auto &b : bodies)
       if (b.rigid_velocity)
@@ -389,6 +429,25 @@ namespace hysteron
                            "reaches x = " + std::to_string(box.get_boundary_points().first[0]) +
                              " < 0, but x is the radius r >= 0 in an axisymmetric scene");
       }
+  }
+
+  template <int dim>
+  void
+  Scene<dim>::refuse_fem_only_sets(const std::string &method, const bool history_tables) const
+  {
+    const std::string why = " is a Gmsh physical group, which only the fem method (with FEM/Mesh/"
+                            "Generator = file) reads; the " +
+                            method + " method needs a set of Faces and/or a Region";
+    for (const auto &b : boundaries)
+      if (!b.physical_group.empty())
+        throw InputError("Boundary " + b.name + "/Set", "the set '" + b.set + "'" + why);
+    for (const auto &l : loads)
+      if (!l.physical_group.empty())
+        throw InputError("Load " + l.name + "/Set", "the set '" + l.set + "'" + why);
+    if (!history_tables && !output.history_sets.empty())
+      throw InputError("Output/History sets",
+                       "the " + method + " method writes no set histories (the fem method does; "
+                       "use probes, averages and reactions.csv)");
   }
 
   template <int dim>

@@ -1,9 +1,13 @@
 #include <deal.II/base/mpi.h>
 
+#include <hysteron/base/plotter.h>
 #include <hysteron/scene/scene.h>
 #include <hysteron/scene/tables.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 
 namespace hysteron
@@ -19,6 +23,9 @@ namespace hysteron
       n_values         = point.size();
       point_names      = point;
       reaction_names   = reaction_columns(scene);
+      history_names.clear();
+      for (const unsigned int k : scene.output_control().history_sets)
+        history_names.push_back(scene.set_descriptions()[k].name);
       if (!scene.is_root())
         return;
       const auto file = [&](const std::string &name) { return directory + "/" + name; };
@@ -38,6 +45,92 @@ namespace hysteron
         }
       energy_table   = std::make_unique<Output::TimeTable>(file("energy.csv"), energy_columns());
       reaction_table = std::make_unique<Output::TimeTable>(file("reactions.csv"), reaction_columns(scene));
+      std::vector<std::string> c{"time"};
+      for (const auto &name : history_columns())
+        c.push_back(name);
+      for (const auto &name : history_names)
+        {
+          history_paths.push_back(file("history_" + name + ".csv"));
+          history_tables.push_back(std::make_unique<Output::TimeTable>(history_paths.back(), c));
+        }
+    }
+
+
+
+    template <int dim>
+    std::vector<std::string>
+    Tables<dim>::history_columns()
+    {
+      std::vector<std::string> c;
+      for (const std::string quantity : {"u", "reaction", "load"})
+        for (unsigned int d = 0; d < dim; ++d)
+          c.push_back(quantity + "_" + "xyz"[d]);
+      return c;
+    }
+
+
+
+    template <int dim>
+    std::vector<std::string>
+    Tables<dim>::draw_histories(const double timeout) const
+    {
+      namespace fs = std::filesystem;
+      std::vector<std::string> warnings;
+      for (unsigned int i = 0; i < history_paths.size(); ++i)
+        {
+          const auto &range = history_ranges[i];
+          if (range.empty())
+            continue; // no row
+          const auto span = [&](const unsigned int column) {
+            return range[column].second - range[column].first;
+          };
+          // The direction where force times displacement varies most, and its force; a set
+          // that does not move (a support): the force that varies most against time.
+          unsigned int c = 0;
+          double       best = -1;
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              const double work = span(d) * std::max(span(dim + d), span(2 * dim + d));
+              if (work > best)
+                {
+                  best = work;
+                  c    = d;
+                }
+            }
+          const bool against_time = best <= 0;
+          if (against_time)
+            for (unsigned int d = 0; d < dim; ++d)
+              if (std::max(span(dim + d), span(2 * dim + d)) > std::max(span(dim + c), span(2 * dim + c)))
+                c = d;
+          const bool         reaction = span(dim + c) >= span(2 * dim + c);
+          const unsigned int force    = (reaction ? dim : 2 * dim) + c;
+          const fs::path     csv(history_paths[i]);
+          const std::string  stem = csv.stem().string();
+          const std::string  axis = std::string(1, "xyz"[c]);
+          const std::string  name = reaction ? "reaction_" + axis : "load_" + axis;
+          // Columns of the CSV: 1 time, then history_columns().
+          std::ofstream gp(csv.parent_path() / (stem + ".gp"));
+          gp << "# The load-displacement curve of " << csv.filename().string() << " (gnuplot " << stem << ".gp)\n"
+             << "set terminal pngcairo noenhanced size 800,600\n"
+             << "set output '" << stem << ".png.tmp'\n"
+             << "set datafile separator ','\n"
+             << "set grid\n"
+             << "set key top left\n"
+             << "set title 'set " << history_names[i] << ": " << name << " against "
+             << (against_time ? "time" : "u_" + axis) << "'\n"
+             << "set xlabel '" << (against_time ? "time [s]" : "u_" + axis + " (mean over the set) [m]") << "'\n"
+             << "set ylabel '" << name << " [N]'\n"
+             << "plot '" << csv.filename().string() << "' skip 1 using " << (against_time ? 1 : 2 + c) << ":"
+             << 2 + force
+             << " with linespoints pointtype 7 pointsize 0.5 title '" << name << "'\n"
+             << "set output\n";
+          gp.close();
+          const std::string warning =
+            Plot::run_gnuplot((csv.parent_path() / (stem + ".gp")).string(), stem + ".png", timeout);
+          if (!warning.empty())
+            warnings.push_back(warning);
+        }
+      return warnings;
     }
 
 
@@ -49,8 +142,13 @@ namespace hysteron
                        std::vector<double>                &averages,
                        std::array<double, 5>               energies,
                        std::vector<dealii::Tensor<1, dim>> reactions,
-                       const MPI_Comm                      comm)
+                       const MPI_Comm                      comm,
+                       std::vector<double>                 histories)
     {
+      const unsigned int n_history = 3 * dim;
+      AssertThrow(histories.size() == history_names.size() * n_history,
+                  dealii::ExcMessage("history rows of " + std::to_string(histories.size()) +
+                                     " values for " + std::to_string(history_names.size()) + " sets"));
       if (has_written && t == last_time)
         return;
       has_written = true;
@@ -64,6 +162,7 @@ namespace hysteron
           for (const auto &r : reactions)
             for (unsigned int d = 0; d < dim; ++d)
               all.push_back(r[d]);
+          all.insert(all.end(), histories.begin(), histories.end());
           MPI_Allreduce(MPI_IN_PLACE, all.data(), all.size(), MPI_DOUBLE, MPI_SUM, comm);
           auto p = all.begin();
           std::copy(p, p + probes.size(), probes.begin());
@@ -75,6 +174,7 @@ namespace hysteron
           for (auto &r : reactions)
             for (unsigned int d = 0; d < dim; ++d)
               r[d] = *p++;
+          std::copy(p, p + histories.size(), histories.begin());
         }
       // The rows on every rank (the values are the same after the reduction), so that
       // a non-finite value stops every rank.
@@ -106,6 +206,17 @@ namespace hysteron
         for (unsigned int d = 0; d < dim; ++d)
           reaction_row.push_back(r[d]);
       check_finite(t, reaction_row, "reactions.csv", reaction_names);
+      std::vector<std::vector<double>> history_rows;
+      std::vector<std::string>         history_header{"time"};
+      for (const auto &name : history_columns())
+        history_header.push_back(name);
+      for (unsigned int i = 0; i < history_names.size(); ++i)
+        {
+          std::vector<double> row{t};
+          row.insert(row.end(), histories.begin() + i * n_history, histories.begin() + (i + 1) * n_history);
+          check_finite(t, row, "history_" + history_names[i] + ".csv", history_header);
+          history_rows.push_back(std::move(row));
+        }
 
       // Only the scene's root opened the tables (comm may be a method's own, e.g.
       // MPI_COMM_SELF for a method that every rank runs whole).
@@ -117,6 +228,20 @@ namespace hysteron
         average_tables[i]->add_row(average_rows[i]);
       energy_table->add_row(energy_row);
       reaction_table->add_row(reaction_row);
+      history_ranges.resize(history_tables.size());
+      for (unsigned int i = 0; i < history_tables.size(); ++i)
+        {
+          history_tables[i]->add_row(history_rows[i]);
+          auto &range = history_ranges[i];
+          if (range.empty())
+            for (unsigned int c = 1; c < history_rows[i].size(); ++c)
+              range.emplace_back(history_rows[i][c], history_rows[i][c]);
+          for (unsigned int c = 1; c < history_rows[i].size(); ++c)
+            {
+              range[c - 1].first  = std::min(range[c - 1].first, history_rows[i][c]);
+              range[c - 1].second = std::max(range[c - 1].second, history_rows[i][c]);
+            }
+        }
     }
 
 
@@ -150,6 +275,8 @@ namespace hysteron
       for (auto &table : probe_tables)
         table->flush();
       for (auto &table : average_tables)
+        table->flush();
+      for (auto &table : history_tables)
         table->flush();
       for (auto *table : {energy_table.get(), reaction_table.get()})
         if (table)

@@ -21,8 +21,10 @@
 #include <hysteron/scene/tables.h>
 #include <hysteron/scene/scene.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -194,6 +196,7 @@ namespace hysteron
         };
         unsigned int load  = 0;   ///< index in the scene's loads
         Kind         kind  = Kind::volume;
+        int          group = -1;  ///< a Gmsh group's tag (faces: traction kind; cells: volume), or -1
         double       scale = 0;   ///< volume: 1 / selected volume; nodal: 1 / nodes; traction: 1
         std::vector<dealii::types::global_dof_index> nodal_dofs; ///< owned, with components
         std::vector<unsigned int>                   nodal_components;
@@ -254,6 +257,38 @@ namespace hysteron
       void
       setup_dynamics();
 
+      // Named sets (sets.cc): Gmsh physical groups and the `History sets` tables.
+      /// Generator = file: the physical tags of the cells of @p serial (before make_mesh()
+      /// sets their bodies) and the group names of the mesh file.
+      void
+      read_physical_groups(const dealii::Triangulation<dim> &serial);
+      /// After the mesh is copied into the distributed triangulation: its coarse cells must be
+      /// those of @p serial in the same order (the groups are stored by coarse cell).
+      void
+      check_coarse_order(const dealii::Triangulation<dim> &serial) const;
+      /// A physical group of the mesh file: boundary faces or cells with this tag.
+      struct PhysicalGroup
+      {
+        bool         faces = true; ///< a group of boundary faces (else of cells)
+        unsigned int tag   = 0;
+      };
+      /// The group named (or numbered) @p group; an InputError at @p where unless the
+      /// mesh file has it.
+      PhysicalGroup
+      physical_group(const std::string &group, const std::string &where) const;
+      /// Whether @p cell (at any level) lies in cell group @p tag.
+      bool
+      in_cell_group(const typename dealii::Triangulation<dim>::cell_iterator &cell, const unsigned int tag) const;
+      /// The locally relevant DoFs of @p group (nodes of its faces or cells), with their components.
+      std::vector<std::pair<dealii::types::global_dof_index, unsigned int>>
+      group_dofs(const PhysicalGroup &group) const;
+      /// The owned DoFs of every history set and the weights of their means (after setup_dirichlet()).
+      void
+      setup_set_histories();
+      /// This rank's part of the history rows: per set the mean displacement, the reaction and the load.
+      std::vector<double>
+      set_history_values() const;
+
       /**
        * The constraints of a step to time @p t1: every prescribed DoF gets the
        * increment of its prescribed displacement from the converged state
@@ -297,11 +332,24 @@ namespace hysteron
       double
       prescribed_velocity(const unsigned int k, const double t, const double dt) const;
 
-      /// Whether x lies in the region of load set @p l.
+      /// Whether the volume load @p l acts at x of a cell that it loads (a group loads all of
+      /// its cells' points, a region those in it).
       bool
       in_region(const unsigned int l, const dealii::Point<dim> &x) const
       {
-        return load_regions[l]->contains(x, 1e-9 * u_scale);
+        return load_sets[l].group >= 0 || load_regions[l]->contains(x, 1e-9 * u_scale);
+      }
+
+      /// Whether the traction of load @p l acts on face @p f of @p cell: a boundary face in
+      /// the group, or whose centre lies in the region.
+      template <typename Iterator>
+      bool
+      loads_face(const unsigned int l, const Iterator &cell, const unsigned int f) const
+      {
+        const auto face = cell->face(f);
+        return face->at_boundary() &&
+               (load_sets[l].group >= 0 ? face->boundary_id() == static_cast<unsigned int>(load_sets[l].group) :
+                                          load_regions[l]->contains(face->center(), 1e-9 * u_scale));
       }
 
       /// The force level of the last evaluation that Newton's tolerance refers to (at
@@ -378,6 +426,19 @@ namespace hysteron
       std::vector<const Material::Interface<dim> *> body_material;
       std::vector<unsigned int>                     body_to_mesh; ///< scene body -> material id
       std::vector<unsigned int>                     mesh_to_body;
+      /// Generator = file: the physical tag of every coarse cell, and the named groups
+      /// ($PhysicalNames: name -> dimension, tag).
+      std::vector<unsigned int>                                   coarse_group;
+      std::map<std::string, std::pair<unsigned int, unsigned int>> physical_names;
+      /// `History sets`: the owned DoFs of each set, their components and the weight 1 / n_c
+      /// of the mean over the set's nodes of each component.
+      struct HistorySet
+      {
+        std::vector<dealii::types::global_dof_index> dofs;
+        std::vector<unsigned int>                   components;
+        std::array<double, dim>                     weight{};
+      };
+      std::vector<HistorySet> history_sets;
       std::vector<std::string>                      state_names;
       bool                                          symmetric_tangent = true;
       bool                                          consistent_tangent = true;

@@ -19,9 +19,9 @@ namespace hysteron
 {
   /**
    * The names of the named subsections of a scene, read in the pre-pass:
-   * `Material names`, `Body names`, `Boundary names`, `Load names`, `Amplitude names`.
-   * Each name N gets `subsection Material N` (resp. `Body N`, `Boundary N`, `Load N`,
-   * `Amplitude N`).
+   * `Material names`, `Body names`, `Boundary names`, `Load names`, `Amplitude names`,
+   * `Set names`. Each name N gets `subsection Material N` (resp. `Body N`, `Boundary N`,
+   * `Load N`, `Amplitude N`, `Set N`).
    */
   struct SceneNames
   {
@@ -30,8 +30,9 @@ namespace hysteron
     std::vector<std::string> boundaries;
     std::vector<std::string> loads;
     std::vector<std::string> amplitudes;
+    std::vector<std::string> sets;
 
-    /// Read the five lists (declared by declare_preamble()) from @p prm.
+    /// Read the six lists (declared by declare_preamble()) from @p prm.
     static SceneNames
     read(const dealii::ParameterHandler &prm);
   };
@@ -84,8 +85,32 @@ namespace hysteron
   };
 
   /**
+   * `subsection Set <name>`: a named selection of nodes, points or cells that
+   * conditions, loads and history tables refer to by name: faces of the domain
+   * box and/or a region (every method), or a physical group of a Gmsh mesh file
+   * (the FEM with `Generator = file`), given by its name or number.
+   */
+  template <int dim>
+  struct SetDescription
+  {
+    std::string               name;
+    std::vector<unsigned int> faces; ///< as BoundaryDescription::faces
+    Geometry::Region<dim>     region; ///< used if has_region
+    bool                      has_region = false;
+    std::string               physical_group; ///< "" : none
+
+    /// Where the set is defined, for messages: "Set <name>".
+    std::string
+    where() const
+    {
+      return "Set " + name;
+    }
+  };
+
+  /**
    * `subsection Boundary <name>`: a kinematic condition on the grid (MPM) or
-   * mesh (FEM) nodes on faces of the domain box and/or inside a region.
+   * mesh (FEM) nodes on faces of the domain box and/or inside a region, or on
+   * a named set (which gives those, or a Gmsh physical group).
    */
   template <int dim>
   struct BoundaryDescription
@@ -110,6 +135,10 @@ namespace hysteron
     std::shared_ptr<dealii::FunctionParser<dim>> displacement;
     /// Multiplies the velocity or the displacement (u(x, t) a(t)); null: 1.
     std::shared_ptr<const Amplitude> amplitude;
+    /// `Set`: the named set the condition acts on ("": its own Faces and Region), and
+    /// the set's Gmsh physical group ("": none; then prescribes() selects nothing and
+    /// the FEM selects the group's nodes).
+    std::string set, physical_group;
 
     /// velocity type: the velocity at @p t (times the amplitude).
     dealii::Tensor<1, dim>
@@ -167,6 +196,9 @@ namespace hysteron
     Geometry::Region<dim>                      region;
     std::shared_ptr<dealii::FunctionParser<1>> value; ///< of t, dim components
     std::shared_ptr<const Amplitude>           amplitude; ///< multiplies value; null: 1
+    /// `Set`: the named set that gives the region ("": `Region`), and its Gmsh physical
+    /// group ("": none; the FEM loads the group's faces or cells).
+    std::string set, physical_group;
 
     /// `Value` at @p t times the amplitude.
     dealii::Tensor<1, dim>
@@ -185,12 +217,22 @@ namespace hysteron
   parse_bodies(dealii::ParameterHandler &prm, const SceneNames &names, const AmplitudeMap &amplitudes);
 
   template <int dim>
+  std::vector<SetDescription<dim>>
+  parse_sets(dealii::ParameterHandler &prm, const SceneNames &names);
+
+  template <int dim>
   std::vector<BoundaryDescription<dim>>
-  parse_boundaries(dealii::ParameterHandler &prm, const SceneNames &names, const AmplitudeMap &amplitudes);
+  parse_boundaries(dealii::ParameterHandler &prm,
+                   const SceneNames &names,
+                   const AmplitudeMap &amplitudes,
+                   const std::vector<SetDescription<dim>> &sets);
 
   template <int dim>
   std::vector<LoadDescription<dim>>
-  parse_loads(dealii::ParameterHandler &prm, const SceneNames &names, const AmplitudeMap &amplitudes);
+  parse_loads(dealii::ParameterHandler &prm,
+              const SceneNames &names,
+              const AmplitudeMap &amplitudes,
+              const std::vector<SetDescription<dim>> &sets);
 
   /// `Gravity` (top level): a vector of dim components [m/s^2]; "" is zero.
   template <int dim>

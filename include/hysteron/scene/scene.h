@@ -61,6 +61,9 @@ namespace hysteron
     double                   progress_interval = 2.0; ///< wall seconds between progress lines
     double                   probe_interval    = 0.0; ///< simulated seconds between table rows
     std::vector<Geometry::Region<dim>> average_regions;
+    /// `History sets`: the sets (indices into Scene::set_descriptions()) whose
+    /// load-displacement history is written to history_<name>.csv (the fem method).
+    std::vector<unsigned int> history_sets;
   };
 
   /// `subsection Checkpoint`: when a time-stepping method saves its state.
@@ -133,6 +136,21 @@ namespace hysteron
     {
       return loads;
     }
+
+    /// The named sets (`Set names`).
+    const std::vector<SetDescription<dim>> &
+    set_descriptions() const
+    {
+      return sets;
+    }
+
+    /**
+     * Throw an InputError naming the entry if the scene asks @p method for what only
+     * the fem method reads: a Gmsh physical group (through a `Set` of a boundary or a
+     * load) or, unless @p history_tables, `Output/History sets`.
+     */
+    void
+    refuse_fem_only_sets(const std::string &method, const bool history_tables = false) const;
 
     /**
      * Whether the scene is a solid of revolution (`Stress state = axisymmetric` in the
@@ -293,6 +311,7 @@ namespace hysteron
     std::vector<BodyDescription<dim>>                               bodies;
     std::vector<BoundaryDescription<dim>>                           boundaries;
     std::vector<LoadDescription<dim>>                               loads;
+    std::vector<SetDescription<dim>>                                sets;
     dealii::Tensor<1, dim>                                          gravity_vector;
     TimeControl                                                     time;
     OutputControl<dim>                                              output;

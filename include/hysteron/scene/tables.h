@@ -23,7 +23,7 @@ namespace hysteron
      * The time tables of a field method (see point_data.h for their columns):
      * probe_<i>.csv, average_<i>.csv, energy.csv and reactions.csv, opened on
      * rank 0 and written from the partial sums of every rank (one reduction per
-     * row, none on one rank).
+     * row, none on one rank), and history_<set>.csv for the scene's `History sets`.
      */
     template <int dim>
     class Tables
@@ -50,7 +50,9 @@ namespace hysteron
        * probe's point fills it, the others leave zeros), @p averages (per region:
        * mass, then the mass-weighted sums of the point values), @p energies
        * (kinetic, strain energy, internal, external and boundary work) and
-       * @p reactions (one per column pair of reactions.csv). The arrays are
+       * @p reactions (one per column pair of reactions.csv) and @p histories (per
+       * history set, history_columns(): the mean displacement, the reaction and
+       * the load, each dim values; empty without history sets). The arrays are
        * summed in place. A second row at the time of the last one is not written
        * (every rank skips it, before the reduction). A NaN or infinite value is
        * never written: every rank throws RuntimeError naming the table, the column
@@ -62,7 +64,22 @@ namespace hysteron
             std::vector<double>                 &averages,
             std::array<double, 5>                energies,
             std::vector<dealii::Tensor<1, dim>>  reactions,
-            const MPI_Comm                       comm);
+            const MPI_Comm                       comm,
+            std::vector<double>                  histories = {});
+
+      /// The columns of history_<set>.csv after `time`: u_x, u_y(, u_z), reaction_x, ...,
+      /// load_x, ...
+      static std::vector<std::string>
+      history_columns();
+
+      /**
+       * Draw each history table as history_<set>.png with gnuplot (rank 0): the force
+       * (reaction or load, whichever varies more) against the mean displacement in the
+       * direction where their product varies most. Returns the warnings (gnuplot missing
+       * or failing); never throws because of the plotter. Call after flush().
+       */
+      std::vector<std::string>
+      draw_histories(double timeout = 60) const;
 
       /// Write the buffered rows of every table (rank 0).
       void
@@ -77,6 +94,10 @@ namespace hysteron
     private:
       std::vector<std::unique_ptr<Output::TimeTable>> probe_tables, average_tables;
       std::unique_ptr<Output::TimeTable>              energy_table, reaction_table;
+      std::vector<std::unique_ptr<Output::TimeTable>> history_tables;
+      std::vector<std::string>                        history_names, history_paths;
+      /// Per history table and column (after time): the smallest and largest value written.
+      std::vector<std::vector<std::pair<double, double>>> history_ranges;
       EnergyLog                                       energy_log;
       unsigned int                                    n_values = 0;
       std::vector<std::string>                        point_names, reaction_names;

@@ -1,7 +1,5 @@
+#include <hysteron/base/plotter.h>
 #include <hysteron/base/run_record.h>
-
-#include "compare/compare.h"
-#include "compare/text.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -11,6 +9,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
+#include <iomanip>
 #include <poll.h>
 #include <spawn.h>
 #include <sstream>
@@ -22,7 +21,7 @@ extern char **environ;
 
 namespace hysteron
 {
-  namespace Compare
+  namespace Plot
   {
     namespace
     {
@@ -48,7 +47,19 @@ namespace hysteron
         if (text.size() > max_message_length)
           text = text.substr(0, max_message_length) + " ...";
         std::replace(text.begin(), text.end(), '\n', ' ');
-        return internal::trim(text);
+        const auto first = text.find_first_not_of(" \t\r");
+        if (first == std::string::npos)
+          return "";
+        return text.substr(first, text.find_last_not_of(" \t\r") - first + 1);
+      }
+
+      /// @p t with 6 significant digits ("0.5", "60").
+      std::string
+      seconds(const double t)
+      {
+        std::ostringstream s;
+        s << std::setprecision(6) << t;
+        return s.str();
       }
 
       /// Whether the child @p pid has exited; it is not reaped (its process group stays).
@@ -190,7 +201,7 @@ namespace hysteron
       std::error_code   ec;
       std::string       failure;
       if (timed_out)
-        failure = "still running after " + internal::number(command.timeout, 6) + " s: killed";
+        failure = "still running after " + seconds(command.timeout) + " s: killed";
       else if (reaped && !WIFEXITED(status))
         failure = "killed by signal " + std::to_string(WTERMSIG(status));
       else if (reaped && WEXITSTATUS(status) != 0)
@@ -251,5 +262,5 @@ namespace hysteron
       command.timeout   = timeout;
       return run_plotter(command);
     }
-  } // namespace Compare
+  } // namespace Plot
 } // namespace hysteron
