@@ -297,7 +297,7 @@ TEST(Scene, RunsAMaterialPointSceneInProcess)
 {
   const std::string        d = fresh_directory("scene");
   dealii::ParameterHandler prm;
-  Scene<3>::declare_parameters(prm, SceneNames{{"soft"}, {}, {}, {}, {}});
+  Scene<3>::declare_parameters(prm, SceneNames{{"soft"}, {}, {}, {}, {}, {}});
   prm.set("Dimension", "3");
   prm.set("Material names", "soft");
   prm.enter_subsection("Material soft");
