@@ -17,6 +17,40 @@ namespace hysteron
 {
   namespace FEM
   {
+    namespace
+    {
+      /**
+       * B-bar (mean dilatation): B_i <- B_i + (b_i - tr B_i) I / dim at every point, with
+       * b_i = sum_q tr B_i(x_q) w_q / sum_q w_q the mean of div N_i over the cell. The
+       * dilatation tr eps of every strain is then its mean over the cell (one volumetric
+       * constraint per cell instead of one per point, so Q1 does not lock in isochoric
+       * flow), and B_i : sigma, B_i : C : B_j are the consistent forces and tangent. In 2D
+       * the trace is the in-plane one (plane strain: eps_zz = 0).
+       */
+      template <int dim>
+      void
+      mean_dilatation(std::vector<std::vector<dealii::SymmetricTensor<2, dim>>> &B,
+                      const std::vector<double>                               &weights)
+      {
+        const unsigned int n_q = weights.size(), n = B[0].size();
+        double             volume = 0;
+        for (unsigned int q = 0; q < n_q; ++q)
+          volume += weights[q];
+        const dealii::SymmetricTensor<2, dim> I = dealii::unit_symmetric_tensor<dim>();
+        for (unsigned int i = 0; i < n; ++i)
+          {
+            double mean = 0;
+            for (unsigned int q = 0; q < n_q; ++q)
+              mean += dealii::trace(B[q][i]) * weights[q];
+            mean /= volume;
+            for (unsigned int q = 0; q < n_q; ++q)
+              B[q][i] += (mean - dealii::trace(B[q][i])) / dim * I;
+          }
+      }
+    } // namespace
+
+
+
     /*
      * The discrete equations. With N_i the vector shape functions, B_i their
      * symmetric gradients, w_q = JxW_q t (t: the thickness in 2D) and the
@@ -239,9 +273,12 @@ namespace hysteron
         for (unsigned int i = 0; i < n; ++i)
           du[i] = u_iterate(dofs[i]) - u_ghost(dofs[i]);
         for (unsigned int q = 0; q < n_q; ++q)
+          for (unsigned int i = 0; i < n; ++i)
+            B[q][i] = fv[displacement].symmetric_gradient(i, q);
+        if (b_bar)
+          mean_dilatation(B, h.weight);
+        for (unsigned int q = 0; q < n_q; ++q)
           {
-            for (unsigned int i = 0; i < n; ++i)
-              B[q][i] = fv[displacement].symmetric_gradient(i, q);
             SymmetricTensor<2, dim> e;
             for (unsigned int i = 0; i < n; ++i)
               if (du[i] != 0)
@@ -302,9 +339,23 @@ namespace hysteron
         for (unsigned int q = 0; q < n_q; ++q)
           {
             const double w = h.weight[q];
+            const SymmetricTensor<2, dim> &s = h.trial_stress[q];
+            if (b_bar)
+              {
+                // The B-bar matrices are not those of one component: contract in full.
+                for (unsigned int i = 0; i < n; ++i)
+                  fi[i] += (B[q][i] * s) * w;
+                if (matrix)
+                  for (unsigned int j = 0; j < n; ++j)
+                    {
+                      const SymmetricTensor<2, dim> CB = h.tangent[q] * B[q][j];
+                      for (unsigned int i = 0; i < n; ++i)
+                        A(i, j) += (B[q][i] * CB) * w;
+                    }
+                continue;
+              }
             for (unsigned int i = 0; i < n; ++i)
               G[i] = fv.shape_grad(i, q);
-            const SymmetricTensor<2, dim> &s = h.trial_stress[q];
             for (unsigned int i = 0; i < n; ++i)
               {
                 double v = 0;
@@ -595,6 +646,7 @@ namespace hysteron
       const FEValuesExtractors::Vector displacement(0);
       std::vector<types::global_dof_index> dofs(n);
       dealii::Vector<double>               xe(n), ye(n);
+      std::vector<std::vector<SymmetricTensor<2, dim>>> B(n_q, std::vector<SymmetricTensor<2, dim>>(n));
       y = 0;
       for (const auto &cell : dof_handler.active_cell_iterators())
         if (cell->is_locally_owned())
@@ -605,15 +657,20 @@ namespace hysteron
             const SymmetricTensor<4, dim> D = h.material->elasticity().template stiffness<dim>();
             for (unsigned int i = 0; i < n; ++i)
               xe[i] = x(dofs[i]);
+            for (unsigned int q = 0; q < n_q; ++q)
+              for (unsigned int i = 0; i < n; ++i)
+                B[q][i] = fv[displacement].symmetric_gradient(i, q);
+            if (b_bar)
+              mean_dilatation(B, h.weight);
             ye = 0;
             for (unsigned int q = 0; q < n_q; ++q)
               {
                 SymmetricTensor<2, dim> e;
                 for (unsigned int i = 0; i < n; ++i)
-                  e += xe[i] * fv[displacement].symmetric_gradient(i, q);
+                  e += xe[i] * B[q][i];
                 const SymmetricTensor<2, dim> s = D * e;
                 for (unsigned int i = 0; i < n; ++i)
-                  ye[i] += (fv[displacement].symmetric_gradient(i, q) * s) * h.weight[q];
+                  ye[i] += (B[q][i] * s) * h.weight[q];
               }
             y.add(dofs, ye);
           }

@@ -58,6 +58,15 @@ namespace hysteron
                           "Polynomial degree p of the FE_Q(p) displacement elements: 1 "
                           "(bilinear / trilinear) or 2 (biquadratic / triquadratic); Gauss "
                           "quadrature with p + 1 points per direction.");
+        prm.declare_entry("B-bar",
+                          "false",
+                          Patterns::Bool(),
+                          "Mean-dilatation (B-bar) elements: the volumetric part of the strain "
+                          "(the in-plane trace in plane strain, the trace in 3D) is replaced by its "
+                          "mean over the cell, in the strain increments, the internal forces and "
+                          "the tangent, so that Q1 does not lock in nearly incompressible "
+                          "(plastic) flow. Plane strain and 3D only (plane stress has no "
+                          "volumetric constraint); not with axisymmetric scenes.");
         prm.declare_entry("Threads",
                           "1",
                           Patterns::Integer(0),
@@ -189,6 +198,22 @@ namespace hysteron
       {
         Section s(prm, {"FEM"});
         degree                 = s.get_integer("Degree");
+        b_bar                  = s.get_bool("B-bar");
+        if (b_bar)
+          {
+            require(!scene.axisymmetric(),
+                    s.where("B-bar"),
+                    "B-bar is not available in an axisymmetric scene (the hoop strain is part of "
+                    "the dilatation)");
+            if (dim == 2)
+              for (const auto &b : scene.body_descriptions())
+                if (!b.rigid)
+                  require(scene.material(b.material, "Body " + b.name + "/Material").elasticity().stress_state ==
+                            Material::StressState::plane_strain,
+                          s.where("B-bar"),
+                          "B-bar needs plane strain, but the material of Body " + b.name +
+                            " is not (plane stress has no volumetric locking)");
+          }
         threads = s.get_integer("Threads");
         const std::string type = s.get("Analysis");
         analysis = type == "quasi-static"      ? Analysis::quasi_static :

@@ -219,6 +219,8 @@ namespace hysteron
 
       // Parameters.
       unsigned int  degree       = 1;
+      /// `FEM/B-bar`: the dilatation of every strain replaced by its mean over the cell.
+      bool          b_bar        = false;
       Analysis      analysis     = Analysis::quasi_static;
       double        fem_time_step = 0;
       unsigned int  n_increments = 100;
