@@ -72,6 +72,8 @@ SCENES = [
     "prm/mpm_beam_collapse.prm", "prm/compare_beam_sinusoidal.prm", "prm/compare_beam_degradation.prm",
     "prm/mpm_taylor_bar_2d.prm", "prm/mpm_taylor_bar_axisymmetric.prm",
     "doc/scenes/mpm_taylor_bar_3d.prm",
+    "prm/compare_portal_frame.prm", "prm/compare_frame_corner.prm",
+    "tests/compare/portal_frame_elastic.prm", "tests/compare/frame_corner_elastic.prm",
 ]
 # Variants of shipped RBSN scenes: name -> (scene, {entry: value}); Write VTU off throughout.
 VARIANTS = {
@@ -87,6 +89,8 @@ VARIANTS = {
 }
 # Rough single-core seconds, to start the long runs first.
 EXPECTED = {"compare_beam_sinusoidal": 300, "compare_beam_degradation": 300, "cantilever_mesh_study": 90,
+            "compare_portal_frame": 100, "compare_frame_corner": 60, "frame_corner_elastic": 25,
+            "portal_frame_elastic": 20,
             "velocity_gradient": 30, "compare_patch_tension": 25, "compare_patch_sinusoidal_kinematic": 20,
             "cells_rbsn_titanium_plate_0.0009": 20, "mpm_beam_collapse": 15,
             "compare_patch_sinusoidal_isotropic": 12, "fem_cantilever_plastic": 10,
@@ -321,6 +325,30 @@ def measure(work, jobs):
     initial_3d = taylor("mpm_taylor_bar_3d", 3, "--initial")
     m["taylor_3d_corrected"] = [v * 0.782 / i if k > 0 else v
                                 for k, (v, i) in enumerate(zip(m["taylor_3d"], initial_3d))]
+    # §5.6 and §5.7, the I-section frames (doc/verification/frames.md).
+    def period(time, u):
+        c = (max(u) + min(u)) / 2
+        z = [t0 + (t1 - t0) * (c - u0) / (u1 - u0)
+             for t0, t1, u0, u1 in zip(time, time[1:], u, u[1:]) if (u0 - c) * (u1 - c) < 0]
+        return 2 * (z[-1] - z[0]) / (len(z) - 1), c
+    c = out("portal_frame_elastic", "compare", "average_0.csv")
+    m["pf_period_fem"], m["pf_mean_fem"] = period(c["time"], c["u_x_FEM"])
+    m["pf_period_mpm"], _ = period(c["time"], c["u_x_MPM"])
+    m["pf_period_fem"], m["pf_period_mpm"], m["pf_mean_fem"] = (1e3 * m["pf_period_fem"], 1e3 * m["pf_period_mpm"],
+                                                                1e3 * m["pf_mean_fem"])
+    c = out("compare_portal_frame", "compare", "average_0.csv")
+    m["pf_peaks"] = [1e3 * max(c["u_x_MPM"]), 1e3 * max(c["u_x_FEM"])]
+    m["pf_first"] = 100 * max(abs(d) for t, d in zip(c["time"], c["u_x_diff"]) if t < 0.04) / max(c["u_x_FEM"])
+    m["pf_all"] = 100 * max(abs(d) for d in c["u_x_diff"]) / max(c["u_x_FEM"])
+    def closing(c, method):
+        return [-(a + b) / math.sqrt(2) for a, b in zip(c["u_x_" + method], c["u_y_" + method])]
+    c = out("frame_corner_elastic", "compare", "average_0.csv")
+    m["fc_k_fem"] = 400e3 / closing(c, "FEM")[-1] / 1e7
+    m["fc_elastic"] = 100 * (closing(c, "MPM")[-1] / closing(c, "FEM")[-1] - 1)
+    c = out("compare_frame_corner", "compare", "average_0.csv")
+    mpm, fem = closing(c, "MPM"), closing(c, "FEM")
+    m["fc_peaks"] = [1e3 * max(mpm), 1e3 * max(fem)]
+    m["fc_set"] = [1e3 * mpm[-1], 1e3 * fem[-1]]
     return m
 
 
@@ -343,6 +371,9 @@ def figures(args, work):
                                           *cases], log=os.path.join(work, "perforated_plate_study.md")),
         Job("make_rbsn_figures.py", [PY, os.path.join(scripts, "make_rbsn_figures.py"), exe],
             log=os.path.join(logs, "make_rbsn_figures.log")),
+        Job("make_frame_figures.sh", ["bash", os.path.join(scripts, "make_frame_figures.sh"), exe,
+                                      os.path.join(work, "runs")],
+            log=os.path.join(logs, "make_frame_figures.log")),
     ]
     run_jobs(jobs, args.jobs, args.core)
     fail_on(jobs)

@@ -6,6 +6,8 @@
    I = 0.545 * 28.28^3 / 12 + 2 (10.5 * 0.76^3 / 12 + 10.5 * 0.76 * 29.04^2 / 4) = 4392.8 in^4
    (the table's 4470 in^4 includes the fillets); with the table's I and a = 1 in,
    b = (4470 - 0.545 * 27.8^3 / 12) / (2 (1 / 12 + 28.8^2 / 4)) = 8.4222 in.
+2b. With --match-area the web's thickness is solved for too: the band has the table's I and A
+   (the W12x120 of prm/compare_portal_frame.prm: b = 0.2797128133 m, t = 0.01523290917 m).
 3. The printed expression is a valid `Thickness`: the FEM weight of a 3 m band of that section
    (D = 0.757 m, Q2 elements whose rows end at the flange, gravity) is rho g L times the band's
    area as printed, to 1e-9.
@@ -48,6 +50,20 @@ close("W30x108 plates I", I, 0.545 * 28.28 ** 3 / 12 + 2 * (10.5 * 0.76 ** 3 / 1
 close("W30x108 plates I (hand)", I, 4392.8, 1e-5)
 I, b, _, _ = run(29.8, 10.5, 0.76, 0.545, "--flange-depth", 1, "--I", 4470)
 close("W30x108, table I, a = 1 in", b, 8.4222, 1e-4)
+
+# 2b. --match-area: the web's thickness is solved for too, so that the band has the table's I
+# and A (W12x120 of prm/compare_portal_frame.prm: D = 1/3 m, a = 1/30 m); its area and second
+# moment, recomputed from b and t, are the table's.
+out = subprocess.run([sys.executable, script] + [str(v) for v in (
+    1 / 3, 0.3124, 0.0281, 0.018, "--flange-depth", 1 / 30, "--I", 4.453676e-4, "--A", 0.02270963,
+    "--match-area")], capture_output=True, text=True).stdout
+bm = float(re.search(r"^b \(flange\)\s*=\s*(\S+)", out, re.M).group(1))
+tm = float(re.search(r"^t \(web\)\s*=\s*(\S+)", out, re.M).group(1))
+Dm, am = 1 / 3, 1 / 30
+close("match-area: area", tm * (Dm - 2 * am) + 2 * am * bm, 0.02270963, 1e-8)
+close("match-area: I", tm * (Dm - 2 * am) ** 3 / 12 + 2 * bm * (am ** 3 / 12 + am * (Dm - am) ** 2 / 4), 4.453676e-4, 1e-8)
+close("match-area: b (prm/compare_portal_frame.prm)", bm, 0.2797128133, 1e-8)
+close("match-area: t (prm/compare_portal_frame.prm)", tm, 0.01523290917, 1e-8)
 
 # 3. The expression in a scene: D = 0.757 m, a = D / 8 (Q2 elements of D / 8: the flange is
 # the outer row of elements), centred on y = 0.
