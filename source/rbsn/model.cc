@@ -183,7 +183,7 @@ namespace hysteron
       , method(method)
       , direct(std::make_unique<SparseLU>())
     {
-      scene.refuse_fem_only_sets("rbsn");
+      scene.refuse_fem_only_sets("rbsn", true);
       {
         Section s(prm, {"RBSN"});
         // A number is a constant d_m; anything else an expression in x and y,
@@ -510,6 +510,28 @@ namespace hysteron
         return std::make_pair(lo, hi);
       }();
       const double tolerance = 1e-9 * scale;
+      // History sets: the cells whose nucleus lies on the set's faces of the nuclei's box
+      // or in its region (the rule of the boundary conditions).
+      history_cells.clear();
+      for (const unsigned int k : scene.output_control().history_sets)
+        {
+          const SetDescription<2>  &d = scene.set_descriptions()[k];
+          std::vector<unsigned int> cells;
+          for (unsigned int c = 0; c < network.cells.size(); ++c)
+            {
+              const auto &x  = network.cells[c].nucleus;
+              bool        in = d.has_region && d.region.contains(x, tolerance);
+              for (const unsigned int face : d.faces)
+                in = in || std::abs(x[face / 2] - (face % 2 == 0 ? box.first[face / 2] : box.second[face / 2])) <= tolerance;
+              if (in)
+                cells.push_back(c);
+            }
+          require(!cells.empty(),
+                  d.where(),
+                  "selects no cell of the network (a cell is selected by its nucleus: on the face "
+                  "of the nuclei's bounding box, or in the region)");
+          history_cells.push_back(std::move(cells));
+        }
       dof_set.assign(3 * network.cells.size(), -1);
       dirichlet.clear();
       const auto take = [&](Dirichlet &set, const unsigned int dof) {
@@ -541,7 +563,7 @@ namespace hysteron
                 take(set, 3 * c + 2);
             }
           require(!set.dofs.empty(),
-                  "Boundary " + d.name + (d.has_region ? "/Region" : "/Faces"),
+                  "Boundary " + d.name + (!d.set.empty() ? "/Set" : d.has_region ? "/Region" : "/Faces"),
                   "selects no cell of the network (a cell is selected by its nucleus: on the face "
                   "of the nuclei's bounding box, or in the region)");
           dirichlet.push_back(std::move(set));

@@ -197,9 +197,24 @@ namespace hysteron
       for (unsigned int i = 0; i < u.size(); ++i)
         if (dof_set[i] >= 0 && i % 3 < 2)
           reactions[dof_set[i]][i % 3] += reaction_old(i);
+      // History sets: the mean displacement of the cells' nuclei, the reaction and the
+      // external force on them (translations; the vectors are whole on every rank).
+      std::vector<double> histories;
+      for (const auto &cells : history_cells)
+        {
+          std::array<double, 6> row{};
+          for (const unsigned int c : cells)
+            for (unsigned int k = 0; k < 2; ++k)
+              {
+                row[k] += u(3 * c + k) / cells.size();
+                row[2 + k] += reaction_old(3 * c + k);
+                row[4 + k] += f_ext_old(3 * c + k);
+              }
+          histories.insert(histories.end(), row.begin(), row.end());
+        }
       tables.write(t, rows, averages,
                    {{kinetic, strain_energy, internal_work, external_work, boundary_work}},
-                   reactions, MPI_COMM_SELF);
+                   reactions, MPI_COMM_SELF, histories);
     }
 
 

@@ -836,6 +836,10 @@ namespace hysteron
     {
       if (spring_table)
         write_spring_table();
+      // The load-displacement curves of the history sets (rank 0; a warning, never an error).
+      tables.flush();
+      for (const auto &warning : tables.draw_histories())
+        std::cerr << "hysteron: warning: " << warning << std::endl;
     }
   } // namespace RBSN
 } // namespace hysteron

@@ -545,6 +545,7 @@ namespace hysteron
       Vector F(n_total);
       residual(t, y, yp, F); // reaction = f_int + M v' + C v - f_ext, f_ext at t
       m.f_ext = f_ext;
+      m.f_ext_old = f_ext; // the converged external force (history tables)
       std::array<double, 6> U;
       for (unsigned int i = 0; i < n; ++i)
         {

@@ -163,9 +163,10 @@ namespace hysteron
       prm.declare_entry("History sets",
                         "",
                         Patterns::Anything(),
-                        "fem method: names of sets (`Set names`) whose history is written every "
-                        "`Probe interval` to history_<name>.csv: the mean displacement of the "
-                        "set's nodes, the reaction on them (the force of the supports, as in "
+                        "fem and rbsn methods: names of sets (`Set names`) whose history is "
+                        "written every `Probe interval` to history_<name>.csv: the mean "
+                        "displacement of the set's nodes (RBSN: of its cells' nuclei), the "
+                        "reaction on them (the force of the supports, as in "
                         "reactions.csv) and the external load on them, side by side (the "
                         "load-displacement curve), drawn at the end of the run in "
                         "history_<name>.png when gnuplot is installed.");
@@ -446,8 +447,8 @@ namespace hysteron
         throw InputError("Load " + l.name + "/Set", "the set '" + l.set + "'" + why);
     if (!history_tables && !output.history_sets.empty())
       throw InputError("Output/History sets",
-                       "the " + method + " method writes no set histories (the fem method does; "
-                       "use probes, averages and reactions.csv)");
+                       "the " + method + " method writes no set histories (the fem and rbsn methods "
+                       "do; use probes, averages and reactions.csv)");
   }
 
   template <int dim>

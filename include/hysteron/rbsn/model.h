@@ -464,6 +464,8 @@ namespace hysteron
       std::string   spring_failure;
       std::string   solver_failure; ///< a singular tangent in the last attempt
       std::vector<int>              probe_cell, probe_facet;
+      /// `Output/History sets`: the cells of each set (nucleus on its box faces or in its region).
+      std::vector<std::vector<unsigned int>> history_cells;
 
       // Fragments (supports.cc): the part of every cell over the intact facets, and the
       // cells a static analysis has released (their fragment is not held).
