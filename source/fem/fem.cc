@@ -158,7 +158,8 @@ namespace hysteron
                             "automatic",
                             Patterns::Selection("automatic|direct|cg|gmres"),
                             "direct: Trilinos Amesos KLU; cg / gmres: with ML algebraic multigrid "
-                            "(elasticity: one constant mode per component); automatic: direct up "
+                            "aggregated on the rigid-body modes of the mesh (translations and "
+                            "rotations); automatic: direct up "
                             "to `Direct solver limit` DoFs, else CG if every material's tangent "
                             "is symmetric, GMRES otherwise.");
           prm.declare_entry("Direct solver package",
@@ -178,6 +179,14 @@ namespace hysteron
                             "1e-10",
                             Patterns::Double(),
                             "Iterative solvers: relative residual reduction, > 0.");
+          prm.declare_entry("Preconditioner reuse",
+                            "true",
+                            Patterns::Bool(),
+                            "cg / gmres: keep the algebraic multigrid hierarchy over Newton "
+                            "iterations and increments while a solve takes at most twice the "
+                            "iterations (plus 10) of the first solve after its set-up; then, or "
+                            "when a solve fails, it is set up again from the current tangent. "
+                            "false: a new hierarchy for every solve.");
           prm.declare_entry("Maximum iterations",
                             "5000",
                             Patterns::Integer(1),
@@ -273,6 +282,7 @@ namespace hysteron
           direct_package = dim == 3 ? "Amesos_Mumps" : "Amesos_Klu";
         solver_tolerance      = s.get_positive("Tolerance");
         solver_max_iterations = s.get_integer("Maximum iterations");
+        reuse_preconditioner  = s.get_bool("Preconditioner reuse");
       }
 
       // What the scene asks of this method.
@@ -446,6 +456,8 @@ namespace hysteron
       if (analysis != Analysis::explicit_dynamics)
         s << ", " << n_newton << " Newton iterations, " << n_cuts << " increment cuts";
       s << ", " << dof_handler.n_dofs() << " DoFs, " << this->n_outputs() << " outputs";
+      if (analysis != Analysis::explicit_dynamics && solver_type != LinearSolver::direct)
+        s << ", " << n_linear << " linear iterations, " << n_amg_setups << " AMG set-ups";
       // The material's share of the timer's "FEM assembly" (this rank's).
       std::ostringstream seconds;
       seconds << std::setprecision(3) << material_seconds;

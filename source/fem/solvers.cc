@@ -12,12 +12,17 @@
 #include <deal.II/lac/solver_gmres.h>
 #include <deal.II/lac/sparsity_tools.h>
 #include <deal.II/lac/trilinos_precondition.h>
+#include <deal.II/lac/trilinos_index_access.h>
 #include <deal.II/lac/trilinos_solver.h>
 
 #include <hysteron/base/newton.h>
 #include <hysteron/base/parameters.h>
 #include <hysteron/fem/fem.h>
 #include <hysteron/geometry/mesh.h>
+
+#include <Epetra_Map.h>
+#include <Epetra_MultiVector.h>
+#include <Teuchos_ParameterList.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -42,45 +47,112 @@ namespace hysteron
           direct.solve(system_matrix, du, system_rhs);
           return 0;
         }
-      TrilinosWrappers::PreconditionAMG                 amg;
-      TrilinosWrappers::PreconditionAMG::AdditionalData data;
-      std::vector<std::vector<bool>>                    modes;
-      {
-        const ComponentMask                           all(dim, true);
-        DoFTools::extract_constant_modes(dof_handler, all, modes);
-      }
-      data.constant_modes        = modes;
-      data.elliptic              = true;
-      data.higher_order_elements = degree > 1;
-      data.smoother_sweeps       = 2;
-      data.aggregation_threshold = 0.02;
-      amg.initialize(system_matrix, data);
-      SolverControl control(solver_max_iterations, std::max(1e-300, solver_tolerance * rhs_norm));
+      const bool reused = amg != nullptr && reuse_preconditioner;
+      if (!reused)
+        setup_amg();
+      // A solve with a kept hierarchy that fails or slows down sets it up again and
+      // repeats (the first solve after a set-up is the reference).
+      const auto attempt = [&](const double tolerance) {
+        SolverControl control(solver_max_iterations, tolerance);
+        if (solver_type == LinearSolver::cg)
+          SolverCG<Vector>(control).solve(system_matrix, du, system_rhs, *amg);
+        else
+          // Right preconditioning: the convergence test sees the true residual.
+          SolverGMRES<Vector>(control, SolverGMRES<Vector>::AdditionalData(100, true))
+            .solve(system_matrix, du, system_rhs, *amg);
+        return control.last_step();
+      };
+      const double tolerance = std::max(1e-300, solver_tolerance * rhs_norm);
+      const Vector start     = du;
+      unsigned int iterations = 0;
       try
         {
-          if (solver_type == LinearSolver::cg)
+          try
             {
-              SolverCG<Vector> cg(control);
-              cg.solve(system_matrix, du, system_rhs, amg);
+              iterations = attempt(tolerance);
             }
-          else
+          catch (const SolverControl::NoConvergence &)
             {
-              // Right preconditioning: the convergence test sees the true residual.
-              SolverGMRES<Vector> gmres(control, SolverGMRES<Vector>::AdditionalData(100, true));
-              gmres.solve(system_matrix, du, system_rhs, amg);
+              if (!reused)
+                throw;
+              iterations = solver_max_iterations;
+            }
+          if (!reused)
+            amg_reference_iterations = iterations;
+          else if (iterations > 2 * amg_reference_iterations + 10)
+            {
+              setup_amg();
+              du                       = start;
+              iterations              += attempt(tolerance);
+              amg_reference_iterations = iterations;
             }
         }
       catch (const SolverControl::NoConvergence &e)
         {
           std::ostringstream m;
           m << "fem: the " << solver_name << " linear solver did not converge in " << e.last_step
-            << " iterations (residual " << e.last_residual << ", target "
-            << control.tolerance() << "); raise FEM/Linear solver/Maximum iterations or use "
-            << "Type = direct";
+            << " iterations (residual " << e.last_residual << ", target " << tolerance
+            << "); raise FEM/Linear solver/Maximum iterations or use Type = direct";
           throw RuntimeError(m.str());
         }
-      return control.last_step();
+      return iterations;
     }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::setup_amg()
+    {
+      // ML smoothed aggregation on the null space of elasticity: per owned row (DoF of
+      // component c at support point x) the translations e_c and the rotations omega x
+      // (x - x_0) about the mesh's centre, scaled by its size (1 in 2D, 3 in 3D).
+      using namespace dealii;
+      TrilinosWrappers::PreconditionAMG::AdditionalData data;
+      data.elliptic              = true;
+      data.higher_order_elements = degree > 1;
+      data.smoother_sweeps       = 2;
+      data.aggregation_threshold = 0.02;
+      Teuchos::ParameterList              list;
+      std::unique_ptr<Epetra_MultiVector> constant_modes;
+      data.set_parameters(list, constant_modes, system_matrix);
+      const Epetra_Map  &map      = system_matrix.trilinos_matrix().RowMap();
+      const int          n_local  = map.NumMyElements();
+      const unsigned int n_modes  = dim == 2 ? 3 : 6;
+      const Point<dim>   centre   = mesh_box.center();
+      amg_null_space.assign(n_modes * n_local, 0.0);
+      for (int i = 0; i < n_local; ++i)
+        {
+          const auto         g = TrilinosWrappers::global_index(map, i);
+          const unsigned int k = owned_dofs.index_within_set(g);
+          const unsigned int c = owned_component[k];
+          const Tensor<1, dim> r = (owned_support[k] - centre) / u_scale;
+          amg_null_space[c * n_local + i] = 1.0;
+          if constexpr (dim == 2)
+            amg_null_space[2 * n_local + i] = c == 0 ? -r[1] : r[0];
+          else
+            {
+              // Rotations about x, y, z: e_a x r has component c equal to eps_{c a b} r_b.
+              for (unsigned int a = 0; a < 3; ++a)
+                {
+                  const unsigned int b = 3 - a - c;
+                  const double       value =
+                    a == c ? 0.0 : ((a - c + 3) % 3 == 1 ? r[b] : -r[b]);
+                  amg_null_space[(3 + a) * n_local + i] = value;
+                }
+            }
+        }
+      list.set("PDE equations", dim);
+      list.set("null space: type", "pre-computed");
+      list.set("null space: dimension", static_cast<int>(n_modes));
+      list.set("null space: vectors", amg_null_space.data());
+      amg = std::make_unique<TrilinosWrappers::PreconditionAMG>();
+      amg->initialize(system_matrix.trilinos_matrix(), list);
+      ++n_amg_setups;
+    }
+
+
+
 
 
 
@@ -139,6 +211,8 @@ namespace hysteron
 
 
 
+    template void Solver<2>::setup_amg();
+    template void Solver<3>::setup_amg();
     template unsigned int Solver<2>::solve_linear(Vector &);
     template unsigned int Solver<3>::solve_linear(Vector &);
     template bool Solver<2>::implicit_step(const double, const double);

@@ -8,6 +8,7 @@
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/fe/mapping_q.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 
@@ -502,6 +503,15 @@ namespace hysteron
       /// first step), for the divergence check of explicit_step().
       double        initial_kinetic = -1;
       std::string   solver_name;
+      /// cg / gmres: ML on the rigid-body modes of the mesh, kept while it serves (solvers.cc).
+      std::unique_ptr<dealii::TrilinosWrappers::PreconditionAMG> amg;
+      std::vector<double> amg_null_space;       ///< the modes' values on the owned rows
+      bool                reuse_preconditioner = true; ///< `Preconditioner reuse`
+      unsigned int        amg_reference_iterations = 0; ///< of the first solve after a set-up
+      unsigned long       n_amg_setups = 0;
+      /// Build the AMG hierarchy of the current system matrix.
+      void
+      setup_amg();
     };
   } // namespace FEM
 } // namespace hysteron
