@@ -47,6 +47,35 @@ namespace hysteron
               B[q][i] += (mean - dealii::trace(B[q][i])) / dim * I;
           }
       }
+
+      /// sym(e_c (x) g): the symmetric gradient of a shape function that moves component c
+      /// with the scalar gradient g.
+      template <int dim>
+      dealii::SymmetricTensor<2, dim>
+      component_gradient(const unsigned int c, const dealii::Tensor<1, dim> &g)
+      {
+        dealii::SymmetricTensor<2, dim> B;
+        for (unsigned int b = 0; b < dim; ++b)
+          B[c][b] = b == c ? g[b] : 0.5 * g[b];
+        return B;
+      }
+
+      /**
+       * Half of the Hughes-Winget rotation (I - W/2)^{-1} (I + W/2) of the spin W: that
+       * rotation turns about the axial vector w of W by 2 atan(|w|/2), so its half turns by
+       * a = atan(|w|/2), by Rodrigues' formula R = I + (sin a / |w|) W + (2 sin^2(a/2) / |w|^2) W^2
+       * (in 2D W^2 = -|w|^2 I and R is the plane rotation by a). |W|_F = sqrt(2) |w|.
+       */
+      template <int dim>
+      dealii::Tensor<2, dim>
+      half_rotation(const dealii::Tensor<2, dim> &W)
+      {
+        const double w  = W.norm() / std::sqrt(2.0);
+        const double a  = std::atan(0.5 * w);
+        const double s1 = w > 0 ? std::sin(a) / w : 0.5;
+        const double s2 = w > 0 ? 2.0 * dealii::Utilities::fixed_power<2>(std::sin(0.5 * a) / w) : 0.125;
+        return dealii::Tensor<2, dim>(dealii::unit_symmetric_tensor<dim>()) + s1 * W + s2 * (W * W);
+      }
     } // namespace
 
 
@@ -81,6 +110,28 @@ namespace hysteron
      * with Rayleigh damping C = a0 M + a1 K0. Everything is formed cell by cell,
      * so that AffineConstraints condenses the prescribed DoFs (and, in the
      * predictor, moves the prescribed increments to the right-hand side).
+     *
+     * Updated Lagrangian (`Kinematics = updated Lagrangian`): x = X + u. With
+     * F = I + grad_X u in the converged (F_n), trial (F_1) and midpoint (F_m = (F_n + F_1)/2)
+     * configurations, a gradient in configuration k is grad_k N = F_k^{-T} grad_X N and a
+     * volume w det F_k. The increment's velocity gradient at the midpoint,
+     * L = grad_X du F_m^{-1}, gives the strain increment d eps = sym L and the spin
+     * W = skew L. The Jaumann rate sigma' = C : d + W sigma - sigma W is C : d in a frame
+     * that turns with the spin: over the step sigma_1 = Q sigma_n Q^T + Q_h (C : d eps) Q_h^T
+     * to second order, with Q the step's rotation and Q_h its half. Hence the stress (and
+     * the material's tensor state) is turned by half the step's rotation, updated, and
+     * turned by the other half,
+     *   sigma_1 = R_h update(R_h sigma_n R_h^T, d eps) R_h^T,   R_h^2 = (I - W/2)^{-1} (I + W/2),
+     * which is exact for rigid rotations: u_1 - u_n = (Q - I) x_n gives L = 2 (Q - I)(Q + I)^{-1},
+     * a skew tensor, so d eps = 0, and the Cayley transform of W/2 is Q itself. Equilibrium holds in the trial configuration,
+     *   f_int,i = sum_q B_i^1 : sigma_1 w_q det F_1,
+     * and the tangent is the material one plus the initial-stress (geometric) stiffness,
+     *   K_ij = sum_q (B_i^1 : C : B_j^m + delta(c_i, c_j) grad_1 N_i . sigma_1 grad_1 N_j) w_q det F_1,
+     * with B_j^m = sym((I - L/2) e_{c_j} (x) grad_m N_j) the derivative of d eps (with B-bar
+     * the mean-dilatation B of the midpoint), and C the material's tangent turned by R_h in its
+     * stress indices; the derivatives of R_h and of the volume, of order sigma / E, are
+     * left out. The
+     * mass, loads (dead loads) and thickness stay those of the reference configuration.
      */
     template <int dim>
     bool
@@ -180,8 +231,19 @@ namespace hysteron
           , G(fe.n_dofs_per_cell())
           , C(dim * dim * dim * dim)
           , H(fe.n_dofs_per_cell() * dim * dim)
+          , Bf(B)
+          , B0(B)
+          , Gs(quadrature.size(), std::vector<Tensor<1, dim>>(fe.n_dofs_per_cell()))
+          , Gf(Gs)
+          , G0(Gs)
+          , w0(quadrature.size())
+          , wm(w0)
+          , w1(w0)
+          , R(quadrature.size())
+          , P(quadrature.size())
+          , sG(fe.n_dofs_per_cell())
         {
-          for (auto *x : {&fx0, &fi0, &du, &v0, &a0, &a1, &v1, &Cv0, &Cv1, &tmp})
+          for (auto *x : {&fx0, &fi0, &du, &u0, &v0, &a0, &a1, &v1, &Cv0, &Cv1, &tmp})
             x->reinit(fe.n_dofs_per_cell());
         }
         Scratch(const Scratch &other)
@@ -190,10 +252,18 @@ namespace hysteron
         FEValues<dim>                                   fv;
         FEFaceValues<dim>                               ffv;
         FullMatrix<double>                              M, K0;
-        dealii::Vector<double>                          fx0, fi0, du, v0, a0, a1, v1, Cv0, Cv1, tmp;
+        dealii::Vector<double>                          fx0, fi0, du, u0, v0, a0, a1, v1, Cv0, Cv1, tmp;
         std::vector<std::vector<SymmetricTensor<2, dim>>> B;
         std::vector<Tensor<1, dim>>                     G; // the shape gradients at one point
         std::vector<double>                             C, H;
+        // Updated Lagrangian: B of the forces (trial configuration, with B-bar) and of
+        // f_int(u_n); the shape gradients in the midpoint, trial and converged configurations;
+        // the volumes w det F there; the rotations; sigma grad N_j at one point.
+        std::vector<std::vector<SymmetricTensor<2, dim>>> Bf, B0;
+        std::vector<std::vector<Tensor<1, dim>>>          Gs, Gf, G0;
+        std::vector<double>                               w0, wm, w1;
+        std::vector<Tensor<2, dim>>                       R, P; ///< P = I - L/2
+        std::vector<Tensor<1, dim>>                       sG;
       };
       struct Copy
       {
@@ -272,11 +342,73 @@ namespace hysteron
         const double      rho = h.material->density();
         for (unsigned int i = 0; i < n; ++i)
           du[i] = u_iterate(dofs[i]) - u_ghost(dofs[i]);
-        for (unsigned int q = 0; q < n_q; ++q)
-          for (unsigned int i = 0; i < n; ++i)
-            B[q][i] = fv[displacement].symmetric_gradient(i, q);
-        if (b_bar)
-          mean_dilatation(B, h.weight);
+        if (finite_strain)
+          {
+            // The kinematics of the increment (see the top of this file).
+            auto &u0 = scratch.u0;
+            for (unsigned int i = 0; i < n; ++i)
+              u0[i] = u_ghost(dofs[i]);
+            const Tensor<2, dim> I = unit_symmetric_tensor<dim>();
+            for (unsigned int q = 0; q < n_q; ++q)
+              {
+                Tensor<2, dim> grad_u0, grad_du;
+                for (unsigned int i = 0; i < n; ++i)
+                  {
+                    const Tensor<1, dim> &g = fv.shape_grad(i, q);
+                    grad_u0[comp[i]] += u0[i] * g;
+                    grad_du[comp[i]] += du[i] * g;
+                  }
+                const Tensor<2, dim> F0 = I + grad_u0, F1 = F0 + grad_du, Fm = F0 + 0.5 * grad_du;
+                const double         J0 = determinant(F0), J1 = determinant(F1), Jm = determinant(Fm);
+                if (!(J1 > 0 && Jm > 0))
+                  {
+                    out.failed = true;
+                    std::ostringstream m;
+                    m << "the element at " << cell->center() << " (body '" << scene.body_descriptions()[h.body].name
+                      << "') turns inside out in the step to t = " << t1 << " s (det F = " << J1
+                      << " at a quadrature point): the increment is too large for the mesh";
+                    out.message = m.str();
+                    return;
+                  }
+                const Tensor<2, dim> inv0T = transpose(invert(F0)), inv1T = transpose(invert(F1)),
+                                     invmT = transpose(invert(Fm));
+                for (unsigned int i = 0; i < n; ++i)
+                  {
+                    const Tensor<1, dim> &g = fv.shape_grad(i, q);
+                    scratch.Gs[q][i] = invmT * g;
+                    scratch.Gf[q][i] = inv1T * g;
+                    scratch.G0[q][i] = inv0T * g;
+                    B[q][i]          = component_gradient(comp[i], scratch.Gs[q][i]);
+                    if (b_bar)
+                      scratch.Bf[q][i] = component_gradient(comp[i], scratch.Gf[q][i]);
+                    if (b_bar && dynamic)
+                      scratch.B0[q][i] = component_gradient(comp[i], scratch.G0[q][i]);
+                  }
+                scratch.w0[q]        = h.weight[q] * J0;
+                scratch.wm[q]        = h.weight[q] * Jm;
+                scratch.w1[q]        = h.weight[q] * J1;
+                h.trial_volume[q]    = scratch.w1[q];
+                const Tensor<2, dim> L = grad_du * transpose(invmT);
+                const Tensor<2, dim> W = 0.5 * (L - transpose(L));
+                scratch.R[q]           = half_rotation(W);
+                scratch.P[q]           = I - 0.5 * L;
+              }
+            if (b_bar)
+              {
+                mean_dilatation(B, scratch.wm);
+                mean_dilatation(scratch.Bf, scratch.w1);
+                if (dynamic)
+                  mean_dilatation(scratch.B0, scratch.w0);
+              }
+          }
+        else
+          {
+            for (unsigned int q = 0; q < n_q; ++q)
+              for (unsigned int i = 0; i < n; ++i)
+                B[q][i] = fv[displacement].symmetric_gradient(i, q);
+            if (b_bar)
+              mean_dilatation(B, h.weight);
+          }
         for (unsigned int q = 0; q < n_q; ++q)
           {
             SymmetricTensor<2, dim> e;
@@ -297,6 +429,15 @@ namespace hysteron
         // The material: from the converged state to the trial state.
         h.trial_stress = h.stress;
         h.trial_state  = h.state;
+        if (finite_strain)
+          for (unsigned int q = 0; q < n_q; ++q)
+            {
+              // The first half of the Jaumann rotation of the stress and of the material's
+              // tensor state.
+              const Tensor<2, dim> &R = scratch.R[q];
+              h.trial_stress[q]       = symmetrize(R * Tensor<2, dim>(h.stress[q]) * transpose(R));
+              h.material->rotate_state(R, ArrayView<double>(h.trial_state.data() + q * h.n_state, h.n_state));
+            }
         const auto material_start = std::chrono::steady_clock::now();
         if (update_material)
           try
@@ -327,6 +468,14 @@ namespace hysteron
         out.material_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - material_start).count();
         if (out.failed)
           return;
+        if (finite_strain)
+          for (unsigned int q = 0; q < n_q; ++q)
+            {
+              // The second half of the rotation (the tangent is turned where it is used).
+              const Tensor<2, dim> &R = scratch.R[q];
+              h.trial_stress[q]       = symmetrize(R * Tensor<2, dim>(h.trial_stress[q]) * transpose(R));
+              h.material->rotate_state(R, ArrayView<double>(h.trial_state.data() + q * h.n_state, h.n_state));
+            }
 
         // Shape function i moves component c_i only, with the gradient g_i of its scalar
         // shape function: B_i = sym(e_{c_i} (x) g_i), so (with the minor symmetries of
@@ -338,24 +487,40 @@ namespace hysteron
           A = 0;
         for (unsigned int q = 0; q < n_q; ++q)
           {
-            const double w = h.weight[q];
+            const double w = finite_strain ? scratch.w1[q] : h.weight[q];
             const SymmetricTensor<2, dim> &s = h.trial_stress[q];
+            if (finite_strain && matrix)
+              {
+                // The initial-stress stiffness delta(c_i, c_j) grad N_i . sigma grad N_j w.
+                const auto &Gf = scratch.Gf[q];
+                for (unsigned int j = 0; j < n; ++j)
+                  scratch.sG[j] = s * Gf[j];
+                for (unsigned int i = 0; i < n; ++i)
+                  for (unsigned int j = 0; j < n; ++j)
+                    if (comp[i] == comp[j])
+                      A(i, j) += (Gf[i] * scratch.sG[j]) * w;
+              }
             if (b_bar)
               {
                 // The B-bar matrices are not those of one component: contract in full.
+                const auto &Bf = finite_strain ? scratch.Bf[q] : B[q];
                 for (unsigned int i = 0; i < n; ++i)
-                  fi[i] += (B[q][i] * s) * w;
+                  fi[i] += (Bf[i] * s) * w;
                 if (matrix)
                   for (unsigned int j = 0; j < n; ++j)
                     {
-                      const SymmetricTensor<2, dim> CB = h.tangent[q] * B[q][j];
+                      SymmetricTensor<2, dim> CB = h.tangent[q] * B[q][j];
+                      if (finite_strain)
+                        CB = symmetrize(scratch.R[q] * Tensor<2, dim>(CB) * transpose(scratch.R[q]));
                       for (unsigned int i = 0; i < n; ++i)
-                        A(i, j) += (B[q][i] * CB) * w;
+                        A(i, j) += (Bf[i] * CB) * w;
                     }
                 continue;
               }
+            // The forces' gradients G (trial configuration) and the strains' (midpoint).
             for (unsigned int i = 0; i < n; ++i)
-              G[i] = fv.shape_grad(i, q);
+              G[i] = finite_strain ? scratch.Gf[q][i] : fv.shape_grad(i, q);
+            const std::vector<Tensor<1, dim>> &Gj = finite_strain ? scratch.Gs[q] : G;
             for (unsigned int i = 0; i < n; ++i)
               {
                 double v = 0;
@@ -372,16 +537,55 @@ namespace hysteron
                     for (unsigned int c = 0; c < dim; ++c)
                       for (unsigned int d = 0; d < dim; ++d)
                         C[((a * dim + b) * dim + c) * dim + d] = T[a][b][c][d];
-                for (unsigned int j = 0; j < n; ++j)
-                  for (unsigned int c = 0; c < dim; ++c)
-                    for (unsigned int b = 0; b < dim; ++b)
-                      {
-                        const double *row = &C[((c * dim + b) * dim + comp[j]) * dim];
-                        double        v   = 0;
-                        for (unsigned int d = 0; d < dim; ++d)
-                          v += row[d] * G[j][d];
-                        H[(j * dim + c) * dim + b] = w * v;
-                      }
+                if (finite_strain)
+                  {
+                    // sigma_1 = R_h S R_h^T: the tangent turned in its stress indices,
+                    // C'_{abkd} = R_ai R_bj C_ijkd (H holds the copy; its use at q comes later).
+                    const Tensor<2, dim> &R = scratch.R[q];
+                    std::copy(C.begin(), C.end(), H.begin());
+                    for (unsigned int a = 0; a < dim; ++a)
+                      for (unsigned int b = 0; b < dim; ++b)
+                        for (unsigned int kd = 0; kd < dim * dim; ++kd)
+                          {
+                            double v = 0;
+                            for (unsigned int i = 0; i < dim; ++i)
+                              for (unsigned int j = 0; j < dim; ++j)
+                                v += R[a][i] * R[b][j] * H[(i * dim + j) * dim * dim + kd];
+                            C[(a * dim + b) * dim * dim + kd] = v;
+                          }
+                  }
+                if (finite_strain)
+                  {
+                    // d(d eps) / du_j = sym((I - L/2) e_{c_j} (x) grad_m N_j) (F_m moves with u_1):
+                    // H_j[c][b] = w C_{c b k d} P_{k c_j} g_j[d] with P = I - L/2.
+                    const Tensor<2, dim> &P = scratch.P[q];
+                    for (unsigned int j = 0; j < n; ++j)
+                      for (unsigned int c = 0; c < dim; ++c)
+                        for (unsigned int b = 0; b < dim; ++b)
+                          {
+                            double v = 0;
+                            for (unsigned int k = 0; k < dim; ++k)
+                              {
+                                const double *row = &C[((c * dim + b) * dim + k) * dim];
+                                double        r   = 0;
+                                for (unsigned int d = 0; d < dim; ++d)
+                                  r += row[d] * Gj[j][d];
+                                v += P[k][comp[j]] * r;
+                              }
+                            H[(j * dim + c) * dim + b] = w * v;
+                          }
+                  }
+                else
+                  for (unsigned int j = 0; j < n; ++j)
+                    for (unsigned int c = 0; c < dim; ++c)
+                      for (unsigned int b = 0; b < dim; ++b)
+                        {
+                          const double *row = &C[((c * dim + b) * dim + comp[j]) * dim];
+                          double        v   = 0;
+                          for (unsigned int d = 0; d < dim; ++d)
+                            v += row[d] * Gj[j][d];
+                          H[(j * dim + c) * dim + b] = w * v;
+                        }
                 for (unsigned int i = 0; i < n; ++i)
                   for (unsigned int j = 0; j < n; ++j)
                     {
@@ -416,20 +620,29 @@ namespace hysteron
             fi0 = 0;
             for (unsigned int q = 0; q < n_q; ++q)
               {
+                // The mass of the reference configuration; damping's K0 in the step's
+                // (midpoint) configuration and f_int(u_n) in the converged one.
                 const double w = h.weight[q];
                 for (unsigned int i = 0; i < n; ++i)
                   for (unsigned int j = 0; j < n; ++j)
                     if (comp[i] == comp[j])
                       M(i, j) += rho * fv.shape_value(i, q) * fv.shape_value(j, q) * w;
+                const double wK = finite_strain ? scratch.wm[q] : w;
                 if (dynamics.rayleigh_stiffness > 0)
                   for (unsigned int j = 0; j < n; ++j)
                     {
                       const SymmetricTensor<2, dim> DB = D * B[q][j];
                       for (unsigned int i = 0; i < n; ++i)
-                        K0(i, j) += (B[q][i] * DB) * w;
+                        K0(i, j) += (B[q][i] * DB) * wK;
                     }
-                for (unsigned int i = 0; i < n; ++i)
-                  fi0[i] += (B[q][i] * h.stress[q]) * w;
+                if (finite_strain)
+                  for (unsigned int i = 0; i < n; ++i)
+                    fi0[i] += (b_bar ? scratch.B0[q][i] * h.stress[q] :
+                                       component_gradient(comp[i], scratch.G0[q][i]) * h.stress[q]) *
+                              scratch.w0[q];
+                else
+                  for (unsigned int i = 0; i < n; ++i)
+                    fi0[i] += (B[q][i] * h.stress[q]) * w;
                 // Axisymmetric: the hoop terms of f_int(u0) and of the elastic K0.
                 if (axisymmetric)
                   add_hoop_terms(lambda_I,
@@ -585,8 +798,10 @@ namespace hysteron
             CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
             for (unsigned int q = 0; q < h.stress.size(); ++q)
               {
-                // Trapezoidal internal work 1/2 (sigma_n + sigma_n+1) : d eps (+ the hoop part).
-                work += 0.5 * ((h.stress[q] + h.trial_stress[q]) * h.increment[q]) * h.weight[q];
+                // Trapezoidal internal work 1/2 (sigma_n + sigma_n+1) : d eps (+ the hoop part),
+                // over the volume of the step's midpoint.
+                work += 0.5 * ((h.stress[q] + h.trial_stress[q]) * h.increment[q]) *
+                        (finite_strain ? 0.5 * (h.volume[q] + h.trial_volume[q]) : h.weight[q]);
                 if (axisymmetric)
                   work += 0.5 * (h.out_of_plane_stress(q, false) + h.out_of_plane_stress(q, true)) *
                           h.hoop_increment[q] * h.weight[q];
@@ -594,6 +809,8 @@ namespace hysteron
               }
             h.stress.swap(h.trial_stress);
             h.state.swap(h.trial_state);
+            if (finite_strain)
+              h.volume = h.trial_volume;
           }
       internal_work += work; // this rank's part (summed when a table row is written)
 

@@ -52,6 +52,7 @@ namespace hysteron
             out.put(h.stress);
             out.put(h.strain);
             out.put(h.state);
+            out.put(h.volume);
             // The tangent of the converged state: the predictor of the next step uses it.
             out.put(h.tangent);
           }
@@ -97,10 +98,12 @@ namespace hysteron
             in.get(h.stress);
             in.get(h.strain);
             in.get(h.state);
+            in.get(h.volume);
             in.get(h.tangent);
             if (h.stress.size() != n_q || h.strain.size() != n_q || h.state.size() != n_state ||
-                h.tangent.size() != n_q)
+                h.volume.size() != n_q || h.tangent.size() != n_q)
               in.refuse("a cell's quadrature-point history has another size than the scene's");
+            h.trial_volume = h.volume;
           }
       in.section("fem sums");
       in.get(internal_work);

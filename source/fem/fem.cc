@@ -67,6 +67,18 @@ namespace hysteron
                           "the tangent, so that Q1 does not lock in nearly incompressible "
                           "(plastic) flow. Plane strain and 3D only (plane stress has no "
                           "volumetric constraint); not with axisymmetric scenes.");
+        prm.declare_entry("Kinematics",
+                          "small strain",
+                          Patterns::Selection("small strain|updated Lagrangian"),
+                          "small strain: equilibrium and strains in the reference configuration "
+                          "(infinitesimal deformation). updated Lagrangian: equilibrium in the "
+                          "current configuration (x = X + u), each increment's strain and spin at "
+                          "the midpoint configuration and the stress (and the material's tensor "
+                          "state) rotated with the Hughes-Winget rotation, i.e. the Jaumann rate "
+                          "of the MPM's `Stress rate = Jaumann`; a rigid rotation leaves the "
+                          "stress unchanged. Loads are dead loads (fixed directions, reference "
+                          "areas); 2D thicknesses stay constant. Not with axisymmetric scenes. "
+                          "See doc/fem.md.");
         prm.declare_entry("Threads",
                           "1",
                           Patterns::Integer(0),
@@ -223,6 +235,11 @@ namespace hysteron
                           "B-bar needs plane strain, but the material of Body " + b.name +
                             " is not (plane stress has no volumetric locking)");
           }
+        finite_strain = s.get("Kinematics") == "updated Lagrangian";
+        require(!finite_strain || !scene.axisymmetric(),
+                s.where("Kinematics"),
+                "the updated-Lagrangian FEM is not available in an axisymmetric scene (use "
+                "small strain, or the MPM with Stress rate = Jaumann)");
         threads = s.get_integer("Threads");
         const std::string type = s.get("Analysis");
         analysis = type == "quasi-static"      ? Analysis::quasi_static :
@@ -332,7 +349,8 @@ namespace hysteron
                                         analysis == Analysis::implicit_dynamics ? "implicit dynamics" :
                                                                                   "explicit dynamics";
       scene.console() << "fem: " << triangulation.n_global_active_cells() << " cells, "
-                      << dof_handler.n_dofs() << " DoFs (Q" << degree << "), " << analysis_name;
+                      << dof_handler.n_dofs() << " DoFs (Q" << degree << (b_bar ? ", B-bar" : "")
+                      << (finite_strain ? ", updated Lagrangian" : "") << "), " << analysis_name;
       if (analysis != Analysis::explicit_dynamics)
         scene.console() << ", " << solver_name << " linear solver";
       else

@@ -312,6 +312,8 @@ namespace hysteron
                 h.point[q]  = fv.quadrature_point(q);
                 h.weight[q] = fv.JxW(q) * this->get_scene().thickness_at(bodies[h.body], h.point[q]);
               }
+            h.volume       = h.weight;
+            h.trial_volume = h.weight;
             // Until a first evaluation: the elastic tangent (the first predictor).
             h.tangent.assign(n_q, h.material->elasticity().template stiffness<dim>());
             if (this->get_scene().axisymmetric())

@@ -194,7 +194,7 @@ namespace hysteron
               {
                 const ArrayView<const double> state(h.state.data() + q * h.n_state, h.n_state);
                 strain_energy +=
-                  h.weight[q] * PointData::strain_energy_density(*h.material, h.stress[q], h.strain[q], state);
+                  h.volume[q] * PointData::strain_energy_density(*h.material, h.stress[q], h.strain[q], state);
                 if (analysis == Analysis::implicit_dynamics)
                   kinetic += 0.5 * rho * vq[q].norm_square() * h.weight[q];
                 for (unsigned int r = 0; r < regions.size(); ++r)

@@ -204,7 +204,15 @@ namespace hysteron
          [&](const unsigned int iteration, const double residual, const double alpha) {
            log_newton(t1, dt, iteration, residual, alpha);
          }});
-      const unsigned int iterations = newton_iterate(problem, newton, residual_floor());
+      // Updated Lagrangian: the strains are differences of gradients of the full motion, so
+      // their round-off is eps |grad x| and that of the forces about eps |K| (u_scale + |u|)
+      // even when the stresses vanish (a rigid rotation): the floor relative to the force level.
+      double floor = residual_floor();
+      if (finite_strain)
+        floor = std::max(floor,
+                         residual_floor() * system_matrix.linfty_norm() * (u_scale + u_trial.linfty_norm()) /
+                           force_level());
+      const unsigned int iterations = newton_iterate(problem, newton, floor);
       n_newton += iterations > 0 ? iterations : newton.max_iterations;
       return iterations > 0;
     }

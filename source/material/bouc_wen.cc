@@ -665,6 +665,9 @@ namespace hysteron
               names[Slots::alpha + f] = std::string("alpha_") + components[f];
           }
         slot_epsp_zz = Slots::epsp + 2;
+        slot_epsp    = Slots::epsp;
+        if (L::is_kinematic)
+          slot_alpha = Slots::alpha;
         if (decltype(s)::value == StressState::plane_strain) // and axisymmetric
           {
             names[Slots::sigma_zz] = "sigma_zz";
@@ -685,6 +688,30 @@ namespace hysteron
           }
       });
     }
+
+    template <int dim>
+    void
+    BoucWen<dim>::rotate_state(const dealii::Tensor<2, dim> &R, const dealii::ArrayView<double> &state) const
+    {
+      // The in-plane (2D) or full (3D) tensor of the slots xx, yy, zz, xy(, yz, xz): turned
+      // as R T R^T; zz of a 2D model is normal to the plane of the rotation.
+      constexpr unsigned int n_pairs     = dim == 3 ? 6 : 4;
+      constexpr unsigned int pairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
+      for (const unsigned int first : {slot_epsp, slot_alpha})
+        if (first != static_cast<unsigned int>(-1))
+          {
+            dealii::SymmetricTensor<2, dim> t;
+            for (unsigned int f = 0; f < n_pairs; ++f)
+              if (pairs[f][0] < dim && pairs[f][1] < dim)
+                t[pairs[f][0]][pairs[f][1]] = state[first + f];
+            const dealii::Tensor<2, dim> turned = R * dealii::Tensor<2, dim>(t) * dealii::transpose(R);
+            for (unsigned int f = 0; f < n_pairs; ++f)
+              if (pairs[f][0] < dim && pairs[f][1] < dim)
+                state[first + f] = 0.5 * (turned[pairs[f][0]][pairs[f][1]] + turned[pairs[f][1]][pairs[f][0]]);
+          }
+    }
+
+
 
     template <int dim>
     void

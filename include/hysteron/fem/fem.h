@@ -81,8 +81,11 @@ namespace hysteron
       /// terms of the hoop strain.
       std::vector<double>                               hoop_increment;
       std::vector<Material::HoopTangent<dim>>           hoop_tangent;
-      /// JxW times the thickness t(x_q) (axisymmetric: times 2 pi r_q)
+      /// JxW times the thickness t(x_q) (axisymmetric: times 2 pi r_q): the reference volume
       std::vector<double>                          weight;
+      /// The volume of the points in the converged and in the trial configuration: the
+      /// weights times det F (updated Lagrangian), else the weights.
+      std::vector<double>                          volume, trial_volume;
       std::vector<dealii::Point<dim>>              point;  ///< quadrature points (reference configuration)
 
       /// 2D: sigma_zz at point q of the trial (or the converged) state (the hoop stress
@@ -222,6 +225,9 @@ namespace hysteron
       unsigned int  degree       = 1;
       /// `FEM/B-bar`: the dilatation of every strain replaced by its mean over the cell.
       bool          b_bar        = false;
+      /// `FEM/Kinematics = updated Lagrangian`: equilibrium in the current configuration,
+      /// strain increments and the Jaumann rotation of the stress at the step's midpoint.
+      bool          finite_strain = false;
       Analysis      analysis     = Analysis::quasi_static;
       double        fem_time_step = 0;
       unsigned int  n_increments = 100;

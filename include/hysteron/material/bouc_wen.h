@@ -100,6 +100,10 @@ namespace hysteron
                    double                                &eps_zz,
                    double                                &sigma_zz) const override;
 
+      /// Turns the plastic strain and the back stress (see Interface::rotate_state()).
+      void
+      rotate_state(const dealii::Tensor<2, dim> &R, const dealii::ArrayView<double> &state) const override;
+
       /// The backward Euler integrator returns the algorithmic tangent; the explicit ones E_t.
       bool
       has_consistent_tangent() const override
@@ -145,6 +149,9 @@ namespace hysteron
       unsigned int slot_sigma_zz = static_cast<unsigned int>(-1);
       unsigned int slot_eps_zz   = static_cast<unsigned int>(-1);
       unsigned int slot_epsp_zz  = static_cast<unsigned int>(-1);
+      /// The first of the tensor components (xx, yy, zz, xy(, yz, xz)) of eps_p and of alpha.
+      unsigned int slot_epsp     = static_cast<unsigned int>(-1);
+      unsigned int slot_alpha    = static_cast<unsigned int>(-1);
       unsigned int slot_eta      = static_cast<unsigned int>(-1);
       unsigned int slot_nu_s     = static_cast<unsigned int>(-1);
     };

@@ -155,6 +155,20 @@ namespace hysteron
         const dealii::ArrayView<dealii::SymmetricTensor<4, dim>>       &tangents,
         const dealii::ArrayView<HoopTangent<dim>>                      &hoop_tangents) const;
 
+      /**
+       * Finite-strain (updated-Lagrangian, Jaumann) analyses: turn the tensor parts of
+       * one point's @p state (e.g. a plastic strain or a back stress) with the increment's
+       * rotation @p R, T <- R T R^T, as the stress is turned before update(), so that the
+       * model stays objective. In 2D @p R turns the plane and leaves zz. Default: the
+       * model has no tensor state.
+       */
+      virtual void
+      rotate_state(const dealii::Tensor<2, dim> &R, const dealii::ArrayView<double> &state) const
+      {
+        (void)R;
+        (void)state;
+      }
+
       /// update() for one point.
       void
       update_point(const dealii::SymmetricTensor<2, dim> &strain_increment,
