@@ -746,7 +746,7 @@ namespace hysteron
                       Filtered(IteratorFilters::LocallyOwnedCell(), dof_handler.end()),
                       worker,
                       copier,
-                      Scratch(mapping, *fe, *quadrature, *face_quadrature),
+                      Scratch(*mapping, *fe, *quadrature, *face_quadrature),
                       Copy(n));
 
       // Forces shared by nodes (a load region without quadrature points).
@@ -792,7 +792,7 @@ namespace hysteron
       using namespace dealii;
       double     work         = 0;
       const bool axisymmetric = this->get_scene().axisymmetric();
-      for (const auto &cell : triangulation.active_cell_iterators())
+      for (const auto &cell : triangulation->active_cell_iterators())
         if (cell->is_locally_owned())
           {
             CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
@@ -859,7 +859,7 @@ namespace hysteron
       using namespace dealii;
       const unsigned int n   = fe->n_dofs_per_cell();
       const unsigned int n_q = quadrature->size();
-      FEValues<dim>      fv(mapping, *fe, *quadrature, update_gradients);
+      FEValues<dim>      fv(*mapping, *fe, *quadrature, update_gradients);
       const FEValuesExtractors::Vector displacement(0);
       std::vector<types::global_dof_index> dofs(n);
       dealii::Vector<double>               xe(n), ye(n);

@@ -45,7 +45,7 @@ namespace hysteron
                               &inertia, &reaction_old})
         put_owned(out, *vector, owned_dofs);
       out.section("fem history");
-      for (const auto &cell : triangulation.active_cell_iterators())
+      for (const auto &cell : triangulation->active_cell_iterators())
         if (cell->is_locally_owned())
           {
             const CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
@@ -90,7 +90,7 @@ namespace hysteron
       v_ghost = v;
       a_ghost = a;
       in.section("fem history");
-      for (const auto &cell : triangulation.active_cell_iterators())
+      for (const auto &cell : triangulation->active_cell_iterators())
         if (cell->is_locally_owned())
           {
             CellHistory<dim> &h = *cell_history[cell->active_cell_index()];

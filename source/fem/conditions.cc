@@ -35,7 +35,7 @@ namespace hysteron
       const Scene<dim> &scene = this->get_scene();
       const auto       &bodies = scene.body_descriptions();
       std::map<dealii::types::global_dof_index, dealii::Point<dim>> support;
-      dealii::DoFTools::map_dofs_to_support_points(mapping, dof_handler, support);
+      dealii::DoFTools::map_dofs_to_support_points(*mapping, dof_handler, support);
       std::map<dealii::types::global_dof_index, unsigned int> component;
       std::vector<dealii::types::global_dof_index>            dofs(fe->n_dofs_per_cell());
       for (const auto &cell : dof_handler.active_cell_iterators())
@@ -215,9 +215,9 @@ namespace hysteron
           load_regions.push_back(&loads[l].region);
         }
       const unsigned int n_loads = load_sets.size();
-      cell_in_load.assign(triangulation.n_active_cells() * n_loads, false);
+      cell_in_load.assign(triangulation->n_active_cells() * n_loads, false);
       std::vector<double> selected(n_loads, 0.0);
-      for (const auto &cell : triangulation.active_cell_iterators())
+      for (const auto &cell : triangulation->active_cell_iterators())
         if (cell->is_locally_owned())
           {
             const CellHistory<dim> &h     = *cell_history[cell->active_cell_index()];

@@ -160,7 +160,7 @@ namespace hysteron
       // lumped (row-sum) masses.
       const unsigned int n   = fe->n_dofs_per_cell();
       const unsigned int n_q = quadrature->size();
-      FEValues<dim>      fv(mapping, *fe, *quadrature, update_values);
+      FEValues<dim>      fv(*mapping, *fe, *quadrature, update_values);
       std::vector<types::global_dof_index> dofs(n);
       const auto &unit_points = fe->get_unit_support_points();
       lumped_mass.reinit(owned_dofs, comm);
@@ -174,16 +174,34 @@ namespace hysteron
             const CellHistory<dim> &h   = *cell_history[cell->active_cell_index()];
             const double            rho = h.material->density();
             m                           = 0;
-            for (unsigned int q = 0; q < n_q; ++q)
-              for (unsigned int i = 0; i < n; ++i)
-                for (unsigned int j = 0; j < n; ++j)
-                  if (fe->system_to_component_index(i).first == fe->system_to_component_index(j).first)
-                    m[i] += rho * fv.shape_value(i, q) * fv.shape_value(j, q) * h.weight[q];
+            if (simplex)
+              {
+                // The row sums of quadratic triangles and tetrahedra vanish or turn negative
+                // at the vertices: the diagonal scaled to the cell's mass instead (Hinton,
+                // Rock and Zienkiewicz), m_i = M_ii rho V / sum_j M_jj over one component.
+                double diagonal = 0, mass = 0;
+                for (unsigned int q = 0; q < n_q; ++q)
+                  {
+                    mass += rho * h.weight[q];
+                    for (unsigned int i = 0; i < n; ++i)
+                      m[i] += rho * fv.shape_value(i, q) * fv.shape_value(i, q) * h.weight[q];
+                  }
+                for (unsigned int i = 0; i < n; ++i)
+                  if (fe->system_to_component_index(i).first == 0)
+                    diagonal += m[i];
+                m *= mass / diagonal;
+              }
+            else
+              for (unsigned int q = 0; q < n_q; ++q)
+                for (unsigned int i = 0; i < n; ++i)
+                  for (unsigned int j = 0; j < n; ++j)
+                    if (fe->system_to_component_index(i).first == fe->system_to_component_index(j).first)
+                      m[i] += rho * fv.shape_value(i, q) * fv.shape_value(j, q) * h.weight[q];
             lumped_mass.add(dofs, m);
             for (unsigned int i = 0; i < n; ++i)
               if (owned_dofs.is_element(dofs[i]))
                 {
-                  const Point<dim> p = mapping.transform_unit_to_real_cell(cell, unit_points[i]);
+                  const Point<dim> p = mapping->transform_unit_to_real_cell(cell, unit_points[i]);
                   velocity(dofs[i]) =
                     bodies[h.body].velocity_at(p)[fe->system_to_component_index(i).first];
                 }
@@ -236,7 +254,7 @@ namespace hysteron
       system_rhs    = 0;
       const unsigned int n   = fe->n_dofs_per_cell();
       const unsigned int n_q = quadrature->size();
-      FEValues<dim>      fv(mapping, *fe, *quadrature, update_values);
+      FEValues<dim>      fv(*mapping, *fe, *quadrature, update_values);
       FullMatrix<double>     M(n, n);
       dealii::Vector<double> rhs(n), ve(n);
       std::vector<types::global_dof_index> dofs(n);

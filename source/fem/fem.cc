@@ -30,10 +30,7 @@ namespace hysteron
   namespace FEM
   {
     template <int dim>
-    Solver<dim>::Solver()
-      : triangulation(MPI_COMM_WORLD)
-      , mapping(1)
-    {}
+    Solver<dim>::Solver() = default;
 
 
 
@@ -129,7 +126,8 @@ namespace hysteron
                             "the bodies' rectangles/boxes (exact for such bodies); unstructured "
                             "(2D): a Delaunay triangulation of the bodies' boundaries, each "
                             "triangle split into three quadrilaterals; file: a Gmsh .msh file of "
-                            "quadrilaterals/hexahedra (`Mesh file`), cells assigned to the body "
+                            "quadrilaterals/hexahedra or of triangles/tetrahedra (`Mesh file`), "
+                            "cells assigned to the body "
                             "that contains their centre; automatic: structured if every body is "
                             "made of rectangles/boxes, else unstructured (2D). See doc/fem.md.");
           prm.declare_entry("Cell size",
@@ -137,6 +135,15 @@ namespace hysteron
                             Patterns::Double(),
                             "Target cell size h [m] of the generated mesh, > 0 (not used with "
                             "`file`).");
+          prm.declare_entry("Cell shape",
+                            "hypercube",
+                            Patterns::Selection("hypercube|simplex"),
+                            "hypercube: the generated mesh of quadrilaterals / hexahedra; simplex: "
+                            "each of its cells split into triangles (8 per quadrilateral) or "
+                            "tetrahedra (24 per hexahedron), with FE_SimplexP elements of the "
+                            "same `Degree`. A mesh file's cells decide by themselves "
+                            "(Generator = file reads quadrilaterals/hexahedra or "
+                            "triangles/tetrahedra). See doc/fem.md.");
           prm.declare_entry("Curved boundary resolution",
                             "0",
                             Patterns::Double(),
@@ -151,7 +158,8 @@ namespace hysteron
                             "",
                             Patterns::Anything(),
                             "Generator = file: a Gmsh .msh file (ASCII or binary, version 2 or "
-                            "4) with quadrilaterals (2D) or hexahedra (3D); a relative name is "
+                            "4) with quadrilaterals / triangles (2D) or hexahedra / tetrahedra "
+                            "(3D), one kind per mesh; a relative name is "
                             "looked up in the working directory, then beside the parameter file.");
         }
         prm.leave_subsection();
@@ -256,6 +264,11 @@ namespace hysteron
         cell_size   = s.get_non_negative("Cell size");
         refinements = s.get_integer("Refinements");
         boundary_resolution = s.get_non_negative("Curved boundary resolution");
+        generate_simplices  = s.get("Cell shape") == "simplex";
+        require(!generate_simplices || generator != "file",
+                s.where("Cell shape"),
+                "a mesh file's cells are read as they are (quadrilaterals / hexahedra or "
+                "triangles / tetrahedra); Cell shape = simplex splits generated meshes only");
         mesh_file   = scene.resolve_input_file(dealii::Utilities::trim(s.get("Mesh file")));
         if (generator == "file")
           {
@@ -348,8 +361,8 @@ namespace hysteron
       const std::string analysis_name = analysis == Analysis::quasi_static      ? "quasi-static" :
                                         analysis == Analysis::implicit_dynamics ? "implicit dynamics" :
                                                                                   "explicit dynamics";
-      scene.console() << "fem: " << triangulation.n_global_active_cells() << " cells, "
-                      << dof_handler.n_dofs() << " DoFs (Q" << degree << (b_bar ? ", B-bar" : "")
+      scene.console() << "fem: " << triangulation->n_global_active_cells() << " cells, "
+                      << dof_handler.n_dofs() << " DoFs (" << (simplex ? "P" : "Q") << degree << (b_bar ? ", B-bar" : "")
                       << (finite_strain ? ", updated Lagrangian" : "") << "), " << analysis_name;
       if (analysis != Analysis::explicit_dynamics)
         scene.console() << ", " << solver_name << " linear solver";

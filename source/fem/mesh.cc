@@ -1,7 +1,12 @@
 // The FEM mesh of the scene's bodies, the DoFs and vectors, and the quadrature-point history.
 #include <deal.II/base/utilities.h>
 #include <deal.II/dofs/dof_tools.h>
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/distributed/shared_tria.h>
 #include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/fe_simplex_p.h>
+#include <deal.II/fe/mapping_fe.h>
+#include <deal.II/grid/grid_generator.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/grid/grid_in.h>
 #include <deal.II/grid/grid_tools.h>
@@ -61,13 +66,17 @@ namespace hysteron
               throw InputError("FEM/Mesh/Mesh file", "cannot read '" + mesh_file + "': " + m.str());
             }
           read_physical_groups(serial);
+          const auto first_kind = serial.begin_active()->reference_cell();
           for (const auto &cell : serial.active_cell_iterators())
             {
-              require(cell->reference_cell() == dealii::ReferenceCells::get_hypercube<dim>(),
+              const auto kind = cell->reference_cell();
+              require((kind == dealii::ReferenceCells::get_hypercube<dim>() ||
+                       kind == dealii::ReferenceCells::get_simplex<dim>()) &&
+                        kind == first_kind,
                       "FEM/Mesh/Mesh file",
-                      "'" + mesh_file + "' has " + cell->reference_cell().to_string() +
-                        " cells; the fem method needs quadrilaterals (2D) or hexahedra (3D) "
-                        "(in Gmsh: Mesh.RecombineAll = 1 and Mesh.SubdivisionAlgorithm = 1)");
+                      "'" + mesh_file + "' has " + kind.to_string() + " and " + first_kind.to_string() +
+                        " cells; the fem method needs one kind: quadrilaterals or triangles "
+                        "(2D), hexahedra or tetrahedra (3D)");
               const auto   centre = cell->center();
               unsigned int body   = dealii::numbers::invalid_unsigned_int;
               for (unsigned int m = 0; m < shapes.size() && body == dealii::numbers::invalid_unsigned_int; ++m)
@@ -83,7 +92,7 @@ namespace hysteron
                 }
               cell->set_material_id(body);
             }
-          triangulation.copy_triangulation(serial);
+          distribute_mesh(serial);
           check_coarse_order(serial);
         }
       else
@@ -124,14 +133,28 @@ namespace hysteron
                         " % of the bodies' volume (a body is not made of rectangles/boxes): "
                         "use Generator = unstructured (2D) or a Gmsh file");
             }
-          triangulation.create_triangulation(mesh.vertices, mesh.cells, dealii::SubCellData());
+          if (generate_simplices)
+            {
+              // Each quadrilateral into 8 triangles, each hexahedron into 24 tetrahedra
+              // (material ids kept).
+              dealii::Triangulation<dim> hypercubes, simplices;
+              hypercubes.create_triangulation(mesh.vertices, mesh.cells, dealii::SubCellData());
+              dealii::GridGenerator::convert_hypercube_to_simplex_mesh(hypercubes, simplices);
+              distribute_mesh(simplices);
+            }
+          else
+            {
+              triangulation = std::make_unique<dealii::parallel::distributed::Triangulation<dim>>(
+                this->get_scene().mpi_communicator());
+              triangulation->create_triangulation(mesh.vertices, mesh.cells, dealii::SubCellData());
+            }
         }
       if (refinements > 0)
         {
           // Each refinement multiplies the cells by 2^dim: refuse a mesh that cannot fit in
           // this machine's memory before making it (it would end in std::bad_alloc after
           // minutes). About 2 kB per quadrature point (history, tangent, matrix rows).
-          const double cells = triangulation.n_global_active_cells() *
+          const double cells = triangulation->n_global_active_cells() *
                                std::pow(2.0, dim * static_cast<double>(refinements));
           const double per_rank =
             cells / dealii::Utilities::MPI::n_mpi_processes(this->get_scene().mpi_communicator());
@@ -140,19 +163,19 @@ namespace hysteron
           if (bytes > memory)
             {
               std::ostringstream m;
-              m << "refining the mesh of " << triangulation.n_global_active_cells() << " cells "
+              m << "refining the mesh of " << triangulation->n_global_active_cells() << " cells "
                 << refinements << " times gives " << cells << " cells (" << per_rank
                 << " per MPI rank), about " << bytes / (1u << 30) << " GiB per rank with Q" << degree
                 << "; this machine has " << memory / (1u << 30)
                 << " GiB: use fewer refinements, a coarser FEM/Mesh/Cell size or more ranks";
               throw InputError("FEM/Mesh/Refinements", m.str());
             }
-          triangulation.refine_global(refinements);
+          triangulation->refine_global(refinements);
         }
 
       // The bounding box of the mesh (faces of boundary conditions) and its scale.
       std::vector<dealii::Point<dim>> corners;
-      for (const auto &cell : triangulation.active_cell_iterators())
+      for (const auto &cell : triangulation->active_cell_iterators())
         if (cell->is_locally_owned())
           for (const unsigned int v : cell->vertex_indices())
             corners.push_back(cell->vertex(v));
@@ -209,15 +232,48 @@ namespace hysteron
 
     template <int dim>
     void
+    Solver<dim>::distribute_mesh(const dealii::Triangulation<dim> &serial)
+    {
+      // p4est has no simplices: a mesh of them is shared by the ranks (every rank keeps the
+      // coarse mesh, METIS gives each its cells), which serves meshes up to a few million cells.
+      MPI_Comm comm = this->get_scene().mpi_communicator();
+      simplex       = serial.begin_active()->reference_cell() == dealii::ReferenceCells::get_simplex<dim>();
+      if (simplex)
+        triangulation = std::make_unique<dealii::parallel::shared::Triangulation<dim>>(
+          comm,
+          dealii::Triangulation<dim>::none,
+          false,
+          dealii::parallel::shared::Triangulation<dim>::partition_metis);
+      else
+        triangulation = std::make_unique<dealii::parallel::distributed::Triangulation<dim>>(comm);
+      triangulation->copy_triangulation(serial);
+    }
+
+
+
+    template <int dim>
+    void
     Solver<dim>::setup_system()
     {
       using namespace dealii;
       const Scene<dim> &scene = this->get_scene();
       MPI_Comm          comm  = scene.mpi_communicator();
-      fe              = std::make_unique<FESystem<dim>>(FE_Q<dim>(degree), dim);
-      quadrature      = std::make_unique<QGauss<dim>>(degree + 1);
-      face_quadrature = std::make_unique<QGauss<dim - 1>>(degree + 1);
-      dof_handler.reinit(triangulation);
+      if (simplex)
+        {
+          // Gauss rules on the simplex exact to degree 2 p + 1 (the mass matrix of P_p).
+          fe              = std::make_unique<FESystem<dim>>(FE_SimplexP<dim>(degree), dim);
+          quadrature      = std::make_unique<QGaussSimplex<dim>>(degree + 1);
+          face_quadrature = std::make_unique<QGaussSimplex<dim - 1>>(degree + 1);
+          mapping         = std::make_unique<MappingFE<dim>>(FE_SimplexP<dim>(1));
+        }
+      else
+        {
+          fe              = std::make_unique<FESystem<dim>>(FE_Q<dim>(degree), dim);
+          quadrature      = std::make_unique<QGauss<dim>>(degree + 1);
+          face_quadrature = std::make_unique<QGauss<dim - 1>>(degree + 1);
+          mapping         = std::make_unique<MappingQ<dim>>(1);
+        }
+      dof_handler.reinit(*triangulation);
       dof_handler.distribute_dofs(*fe);
       owned_dofs = dof_handler.locally_owned_dofs();
       DoFTools::extract_locally_relevant_dofs(dof_handler, relevant_dofs);
@@ -280,13 +336,13 @@ namespace hysteron
     {
       const auto &bodies = this->get_scene().body_descriptions();
       const unsigned int n_q = quadrature->size();
-      dealii::FEValues<dim> fv(mapping, *fe, *quadrature,
+      dealii::FEValues<dim> fv(*mapping, *fe, *quadrature,
                                dealii::update_quadrature_points | dealii::update_JxW_values);
-      history.initialize(triangulation.begin_active(), triangulation.end(), 1);
+      history.initialize(triangulation->begin_active(), triangulation->end(), 1);
       // Raw pointers by active cell index: get_data() returns a vector of shared
       // pointers (an allocation per call), too slow for the assembly loops.
-      cell_history.assign(triangulation.n_active_cells(), nullptr);
-      for (const auto &cell : triangulation.active_cell_iterators())
+      cell_history.assign(triangulation->n_active_cells(), nullptr);
+      for (const auto &cell : triangulation->active_cell_iterators())
         if (cell->is_locally_owned())
           {
             cell_history[cell->active_cell_index()] = history.get_data(cell)[0].get();

@@ -30,7 +30,7 @@ namespace hysteron
           bool found = false;
           try
             {
-              const auto cell_and_point = GridTools::find_active_cell_around_point(mapping, dof_handler, p);
+              const auto cell_and_point = GridTools::find_active_cell_around_point(*mapping, dof_handler, p);
               if (cell_and_point.first.state() == IteratorState::valid &&
                   cell_and_point.first->is_locally_owned())
                 {
@@ -55,7 +55,7 @@ namespace hysteron
 
           // The nearest quadrature point (ties: the lowest rank, then the first found).
           double best = std::numeric_limits<double>::max();
-          for (const auto &cell : triangulation.active_cell_iterators())
+          for (const auto &cell : triangulation->active_cell_iterators())
             if (cell->is_locally_owned())
               {
                 const CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
@@ -162,7 +162,7 @@ namespace hysteron
           if (probes[i].has_cell)
             {
               const Quadrature<dim> at(probes[i].reference);
-              FEValues<dim>         fv(mapping, *fe, at, update_values);
+              FEValues<dim>         fv(*mapping, *fe, at, update_values);
               fv.reinit(probes[i].dof_cell);
               std::vector<Tensor<1, dim>> uu(1), vv(1);
               fv[displacement].get_function_values(u_ghost, uu);
@@ -180,7 +180,7 @@ namespace hysteron
       std::vector<double> averages(regions.size() * (1 + n_values), 0.0), values(n_values);
       double              kinetic = 0, strain_energy = 0;
       const unsigned int  n_q = quadrature->size();
-      FEValues<dim>       fv(mapping, *fe, *quadrature, update_values);
+      FEValues<dim>       fv(*mapping, *fe, *quadrature, update_values);
       std::vector<Tensor<1, dim>> uq(n_q), vq(n_q);
       for (const auto &cell : dof_handler.active_cell_iterators())
         if (cell->is_locally_owned())
@@ -226,14 +226,14 @@ namespace hysteron
     {
       using namespace dealii;
       // Cell averages of the quadrature-point values.
-      const unsigned int n_cells = triangulation.n_active_cells();
+      const unsigned int n_cells = triangulation->n_active_cells();
       const unsigned int n_sym   = SymmetricTensor<2, dim>::n_independent_components;
       std::vector<dealii::Vector<float>> stress(n_sym, dealii::Vector<float>(n_cells)),
         strain(n_sym, dealii::Vector<float>(n_cells)),
         state(state_names.size(), dealii::Vector<float>(n_cells));
       dealii::Vector<float> von_mises(n_cells), body(n_cells), subdomain(n_cells);
       std::vector<double>   values(PointData::columns<dim>(state_names).size());
-      for (const auto &cell : triangulation.active_cell_iterators())
+      for (const auto &cell : triangulation->active_cell_iterators())
         if (cell->is_locally_owned())
           {
             const CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
@@ -260,7 +260,7 @@ namespace hysteron
                   state[k][c] += w * values[3 * dim + 2 * n_sym + 1 + k];
               }
             body[c]      = h.body;
-            subdomain[c] = triangulation.locally_owned_subdomain();
+            subdomain[c] = triangulation->locally_owned_subdomain();
           }
       DataOut<dim> data_out;
       data_out.attach_dof_handler(dof_handler);
@@ -281,7 +281,7 @@ namespace hysteron
         data_out.add_data_vector(state[k], state_names[k], DataOut<dim>::type_cell_data);
       data_out.add_data_vector(body, "body", DataOut<dim>::type_cell_data);
       data_out.add_data_vector(subdomain, "subdomain", DataOut<dim>::type_cell_data);
-      data_out.build_patches(mapping, degree);
+      data_out.build_patches(*mapping, simplex ? 1 : degree);
       writer.write(data_out, t);
     }
 
@@ -297,7 +297,7 @@ namespace hysteron
       const unsigned int width   = columns.size() + 1 + dim;
       const unsigned int n_q     = quadrature->size();
       const FEValuesExtractors::Vector displacement(0);
-      FEValues<dim>               fv(mapping, *fe, *quadrature, update_values);
+      FEValues<dim>               fv(*mapping, *fe, *quadrature, update_values);
       std::vector<Tensor<1, dim>> uq(n_q), vq(n_q);
       std::vector<double>         rows;
       for (const auto &cell : dof_handler.active_cell_iterators())

@@ -70,8 +70,8 @@ namespace hysteron
     void
     Solver<dim>::check_coarse_order(const dealii::Triangulation<dim> &serial) const
     {
-      AssertThrow(triangulation.n_cells(0) == serial.n_cells(0), dealii::ExcInternalError());
-      auto copy = triangulation.begin(0);
+      AssertThrow(triangulation->n_cells(0) == serial.n_cells(0), dealii::ExcInternalError());
+      auto copy = triangulation->begin(0);
       for (auto cell = serial.begin(0); cell != serial.end(0); ++cell, ++copy)
         AssertThrow(copy->index() == cell->index() &&
                       copy->center().distance(cell->center()) <= 1e-12 * cell->diameter(),
@@ -92,7 +92,7 @@ namespace hysteron
       // Which tags the mesh has on its boundary faces and on its cells (all ranks).
       const auto present = [&](const unsigned int tag, const bool faces) {
         bool found = false;
-        for (const auto &cell : triangulation.active_cell_iterators())
+        for (const auto &cell : triangulation->active_cell_iterators())
           if (!found && cell->is_locally_owned())
             {
               if (!faces)

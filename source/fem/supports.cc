@@ -22,10 +22,10 @@ namespace hysteron
 
       // The coarse cells joined through shared vertices: the mesh's connected parts.
       // Refinement does not change them, and every rank holds the whole coarse mesh.
-      const unsigned int        n_coarse = triangulation.n_cells(0);
+      const unsigned int        n_coarse = triangulation->n_cells(0);
       ConnectedParts            connected(n_coarse);
-      std::vector<unsigned int> vertex_cell(triangulation.n_vertices(), numbers::invalid_unsigned_int);
-      for (auto cell = triangulation.begin(0); cell != triangulation.end(0); ++cell)
+      std::vector<unsigned int> vertex_cell(triangulation->n_vertices(), numbers::invalid_unsigned_int);
+      for (auto cell = triangulation->begin(0); cell != triangulation->end(0); ++cell)
         for (const unsigned int v : cell->vertex_indices())
           {
             unsigned int &first = vertex_cell[cell->vertex_index(v)];
@@ -41,7 +41,7 @@ namespace hysteron
       std::vector<bool>                  seen(n_parts, false);
       std::vector<std::set<std::string>> names(n_parts);
       const auto                        &bodies = this->get_scene().body_descriptions();
-      for (auto cell = triangulation.begin(0); cell != triangulation.end(0); ++cell)
+      for (auto cell = triangulation->begin(0); cell != triangulation->end(0); ++cell)
         {
           const unsigned int p = part[cell->index()];
           for (const unsigned int v : cell->vertex_indices())

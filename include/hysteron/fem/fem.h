@@ -4,6 +4,7 @@
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/base/quadrature_point_data.h>
 #include <deal.II/distributed/tria.h>
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/fe/mapping_q.h>
@@ -237,6 +238,8 @@ namespace hysteron
       double        boundary_resolution = 0; ///< segment length of curved boundaries, 0: h/2
       unsigned int  refinements  = 0;
       std::string   mesh_file;
+      /// `FEM/Mesh/Cell shape = simplex`: generated meshes split into triangles / tetrahedra.
+      bool          generate_simplices = false;
       NewtonParameters newton;
       ImplicitDynamicsParameters dynamics;
       LinearSolver  solver_type = LinearSolver::automatic;
@@ -267,6 +270,10 @@ namespace hysteron
       setup_dynamics();
 
       // Named sets (sets.cc): Gmsh physical groups and the `History sets` tables.
+      /// Move the coarse mesh @p serial into the parallel triangulation (p4est for hypercubes,
+      /// shared for simplices; refused if it mixes the two).
+      void
+      distribute_mesh(const dealii::Triangulation<dim> &serial);
       /// Generator = file: the physical tags of the cells of @p serial (before make_mesh()
       /// sets their bodies) and the group names of the mesh file.
       void
@@ -418,13 +425,15 @@ namespace hysteron
       std::vector<dealii::Tensor<1, dim>>
       reactions() const;
 
-      // The discretisation.
-      dealii::parallel::distributed::Triangulation<dim> triangulation;
+      // The discretisation: quadrilaterals / hexahedra on a p4est triangulation, or
+      // triangles / tetrahedra (FE_SimplexP, Gauss-simplex rules) on a shared one.
+      std::unique_ptr<dealii::parallel::TriangulationBase<dim>> triangulation;
+      bool                                               simplex = false;
       std::unique_ptr<dealii::FESystem<dim>>            fe;
-      dealii::MappingQ<dim>                             mapping;
+      std::unique_ptr<dealii::Mapping<dim>>             mapping;
       dealii::DoFHandler<dim>                           dof_handler;
-      std::unique_ptr<dealii::QGauss<dim>>              quadrature;
-      std::unique_ptr<dealii::QGauss<dim - 1>>          face_quadrature;
+      std::unique_ptr<dealii::Quadrature<dim>>          quadrature;
+      std::unique_ptr<dealii::Quadrature<dim - 1>>      face_quadrature;
       dealii::IndexSet                                  owned_dofs, relevant_dofs;
       dealii::AffineConstraints<double>                 constraints;
       Matrix                                            system_matrix;
