@@ -18,6 +18,7 @@ packages=(
   libsuitesparse-dev  # UMFPACK, called directly for the RBSN's kept symbolic analysis
   libopenblas0-serial # an optimised BLAS/LAPACK behind libblas.so.3 (the sparse direct
                       # solvers' dense kernels; Debian's default is the reference BLAS)
+  calculix-ccx        # benchmarks/calculix_cantilever_3d.py: the 3D FEM against CalculiX
 )
 
 missing=()

@@ -42,9 +42,10 @@ namespace hysteron
       const double rhs_norm = system_rhs.l2_norm();
       if (solver_type == LinearSolver::direct)
         {
-          SolverControl                    control(1, 0);
-          TrilinosWrappers::SolverDirect   direct(control, TrilinosWrappers::SolverDirect::AdditionalData(false, direct_package));
-          direct.solve(system_matrix, du, system_rhs);
+          // The pattern is that of the whole run: its analysis is done once.
+          if (!direct_solver)
+            direct_solver = std::make_unique<KeptDirectSolver>(direct_package);
+          direct_solver->solve(system_matrix, du, system_rhs);
           return 0;
         }
       const bool reused = amg != nullptr && reuse_preconditioner;

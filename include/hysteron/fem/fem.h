@@ -13,6 +13,7 @@
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 
+#include <hysteron/base/direct_solver.h>
 #include <hysteron/base/implicit_dynamics.h>
 #include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>
@@ -518,6 +519,8 @@ namespace hysteron
       /// first step), for the divergence check of explicit_step().
       double        initial_kinetic = -1;
       std::string   solver_name;
+      /// direct: Amesos with the symbolic analysis of the (fixed) pattern kept over the run.
+      std::unique_ptr<KeptDirectSolver> direct_solver;
       /// cg / gmres: ML on the rigid-body modes of the mesh, kept while it serves (solvers.cc).
       std::unique_ptr<dealii::TrilinosWrappers::PreconditionAMG> amg;
       std::vector<double> amg_null_space;       ///< the modes' values on the owned rows
