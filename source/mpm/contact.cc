@@ -126,7 +126,8 @@ namespace hysteron
       const unsigned int first_rigid_reaction = boundaries.size();
 
       // Per node: the trial velocity v_b' of each body with mass there.
-      std::vector<Tensor<1, dim>> &v = contact_velocity;
+      std::vector<Tensor<1, dim>> &v                = contact_velocity;
+      const bool                   first_conversion = layer_from_points;
       for (const unsigned int n : active_nodes)
         {
           double *const       q_n = layer + n * L;
@@ -181,14 +182,12 @@ namespace hysteron
               for (unsigned int d = 0; d < dim; ++d)
                 {
                   const double v0 = layer_holds_momenta ? q[1 + d] * inv_m : q[1 + d];
-                  if (record)
-                    {
-                      q[1 + dim + d] = dt * q[1 + dim + d] * inv_m; // Delta v_b before contact
-                      v[b][d]        = v0 + q[1 + dim + d];
-                      q[1 + d]       = v0; // v_b at the step's start, for Delta v_b below
-                    }
-                  else
-                    v[b][d] = v0;
+                  // The velocity projected from the points, for the FLIP increment
+                  // Delta v_b = v_b' - p_b / m_b (a correction at the step's start, USF,
+                  // belongs to it too).
+                  if (first_conversion)
+                    q[1 + 3 * dim + d] = v0;
+                  v[b][d] = record ? v0 + dt * q[1 + dim + d] * inv_m : v0;
                 }
               m_total += q[0];
               p_total += q[0] * v[b];
@@ -263,7 +262,7 @@ namespace hysteron
               for (unsigned int d = 0; d < dim; ++d)
                 {
                   if (record)
-                    q[1 + dim + d] = v[b][d] - q[1 + d]; // Delta v_b = v_b' - v_b
+                    q[1 + dim + d] = v[b][d] - q[1 + 3 * dim + d];
                   q[1 + d] = v[b][d];
                 }
               // The force of a rigid body on the material, and its work.
@@ -276,6 +275,7 @@ namespace hysteron
             }
         }
       layer_holds_momenta = false;
+      layer_from_points   = false;
     }
 
 

@@ -236,10 +236,11 @@ namespace hysteron
 
       // Contact (`MPM/Contact`, contact.cc): every body has its own nodal mass,
       // momentum, force and mass gradient in the grid's layer (block b of a node
-      // is body b: contact_block doubles in the order of the common field, then
-      // the mass gradient); where two or more bodies have mass at a node their
-      // velocities are corrected so that they do not interpenetrate.
-      static constexpr unsigned int contact_block = 1 + 3 * dim;
+      // is body b: contact_block doubles, m, p or v, f or Delta v as in the common
+      // field, then the mass gradient and the velocity projected from the points);
+      // where two or more bodies have mass at a node their velocities are corrected
+      // so that they do not interpenetrate.
+      static constexpr unsigned int contact_block = 1 + 4 * dim;
       bool                          contact       = false;
       /// With contact: the blocks per node of the layer (one per body).
       unsigned int                  n_contact_blocks = 0;
@@ -247,6 +248,8 @@ namespace hysteron
       std::vector<double>           friction;
       /// Whether the layer holds momenta (after a transfer) or velocities.
       bool                          layer_holds_momenta = true;
+      /// Whether the layer holds the momenta of particles_to_grid() (not yet converted).
+      bool                          layer_from_points = true;
       /// Per local node: is it a node of a boundary condition (contact only).
       std::vector<unsigned char>    contact_boundary_node;
       /// Scratch of apply_contact(): per body, the trial and the rigid velocities.

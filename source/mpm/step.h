@@ -225,6 +225,7 @@ namespace hysteron
         {
           grid->exchange_layer(0, K);
           layer_holds_momenta = true;
+          layer_from_points   = true;
         }
     }
 
