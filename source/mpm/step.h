@@ -155,18 +155,23 @@ namespace hysteron
                   if constexpr (with_contact)
                     {
                       double *const block = layer + std::size_t(group.rigid_body) * K;
+                      const double  ms    = m / particles.thickness[p];
                       support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
                         double *const q = block + n * L;
                         q[0] += N * m;
                         for (unsigned int d = 0; d < dim; ++d)
-                          q[1 + 2 * dim + d] += m * grad[d];
+                          q[1 + 2 * dim + d] += ms * grad[d];
                       });
                     }
                   continue;
                 }
               const Tensor<1, dim> mv = m * cur.v[p];
-              double *const        block =
+              // Contact: the body's block, and the point's mass per unit thickness (2D) or
+              // per radian of ring (axisymmetric) for the mass gradient: the normal is that
+              // of the section, whatever the thickness or the radius.
+              double *const block =
                 with_contact ? layer + std::size_t(particles.body[p]) * K : nullptr;
+              const double ms = with_contact ? m / particles.thickness[p] : 0.0;
               if constexpr (with_forces)
                 {
                   // f_i += N_ip (m_p g + f_p) - V_p sigma_p grad N_ip (axisymmetric: and
@@ -193,7 +198,7 @@ namespace hysteron
                           {
                             q[1 + d] += N * mv[d];
                             q[1 + dim + d] += f[d];
-                            q[1 + 2 * dim + d] += m * grad[d];
+                            q[1 + 2 * dim + d] += ms * grad[d];
                           }
                       }
                   });
@@ -211,7 +216,7 @@ namespace hysteron
                       for (unsigned int d = 0; d < dim; ++d)
                         {
                           q[1 + d] += N * mv[d];
-                          q[1 + 2 * dim + d] += m * grad[d];
+                          q[1 + 2 * dim + d] += ms * grad[d];
                         }
                     }
                   else
