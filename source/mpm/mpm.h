@@ -381,7 +381,7 @@ namespace hysteron
 
 
     /// The phases of the step with the basis @p Basis, with or without contact
-    /// (instantiated in step_linear.cc, step_cubic.cc, step_contact.cc).
+    /// (instantiated in step_linear.cc, step_cubic.cc and their *_contact.cc).
     template <int dim, typename Basis, bool with_contact>
     std::unique_ptr<StepPhases<dim>>
     make_step_phases(Solver<dim> &solver);
