@@ -178,6 +178,10 @@ namespace hysteron
                 impose(r, c, v[b][c], n, reactions[boundaries.size() + b]);
             }
         }
+
+      // Contact: the bodies' own velocities (rigid bodies act here, not on rigid_nodes).
+      if (contact)
+        apply_contact(t, dt, record);
     }
 
 

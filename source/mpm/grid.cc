@@ -61,10 +61,6 @@ namespace hysteron
           connection.disconnect();
         }
 
-      fe = std::make_unique<FESystem<dim>>(FE_Q<dim>(1), n_comp);
-      dof_handler.reinit(tria);
-      dof_handler.distribute_dofs(*fe);
-
       // Which lattice cell is which triangulation cell, and who owns it.
       owned_cell.assign(n_lattice_cells, 0);
       cell_index.assign(n_lattice_cells, -1);
@@ -100,18 +96,36 @@ namespace hysteron
         }
       relevant_node.assign(n_box_nodes, 0);
       owned_node.assign(n_box_nodes, 0);
+
+      main.n_comp = n_comp;
+      connect(main, true);
       nodes.assign(std::size_t(n_box_nodes) * n_comp, 0.0);
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::connect(Field &field, const bool set_node_flags)
+    {
+      using namespace dealii;
+      field.fe = std::make_unique<FESystem<dim>>(FE_Q<dim>(1), field.n_comp);
+      field.dof_handler.reinit(tria);
+      field.dof_handler.distribute_dofs(*field.fe);
 
       IndexSet relevant;
-      DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
-      const IndexSet &owned = dof_handler.locally_owned_dofs();
-      buffer.reinit(owned, relevant, comm);
-      const auto &partitioner = *buffer.get_partitioner();
+      DoFTools::extract_locally_relevant_dofs(field.dof_handler, relevant);
+      const IndexSet &owned = field.dof_handler.locally_owned_dofs();
+      field.buffer.reinit(owned, relevant, comm);
+      const auto &partitioner = *field.buffer.get_partitioner();
 
-      std::vector<int> box_of_local(owned.n_elements() + partitioner.n_ghost_indices(), -1);
-      ghost_nodes.clear();
-      import_nodes.clear();
-      for (const auto &cell : dof_handler.active_cell_iterators())
+      std::vector<int>           box_of_local(owned.n_elements() + partitioner.n_ghost_indices(), -1);
+      std::vector<unsigned char> seen(n_box_nodes, 0);
+      field.ghost_nodes.clear();
+      field.import_nodes.clear();
+      const Point<dim> &lower = grid_lattice.origin;
+      const double      h     = grid_lattice.h;
+      for (const auto &cell : field.dof_handler.active_cell_iterators())
         if (!cell->is_artificial())
           for (const unsigned int v : cell->vertex_indices())
             {
@@ -119,25 +133,45 @@ namespace hysteron
               for (unsigned int d = 0; d < dim; ++d)
                 i[d] = static_cast<int>(std::lround((cell->vertex(v)[d] - lower[d]) / h));
               const unsigned int n = local_node(i);
-              if (relevant_node[n])
+              if (seen[n])
                 continue;
-              relevant_node[n]                = 1;
+              seen[n]                         = 1;
               const types::global_dof_index g = cell->vertex_dof_index(v, 0);
-              for (unsigned int c = 1; c < n_comp; ++c)
+              for (unsigned int c = 1; c < field.n_comp; ++c)
                 Assert(cell->vertex_dof_index(v, c) == g + c, ExcInternalError());
-              owned_node[n]        = owned.is_element(g) ? 1 : 0;
+              const bool is_owned = owned.is_element(g);
+              if (set_node_flags)
+                {
+                  relevant_node[n] = 1;
+                  owned_node[n]    = is_owned ? 1 : 0;
+                }
               const unsigned int l = partitioner.global_to_local(g);
               box_of_local[l]      = n;
-              if (!owned_node[n])
-                ghost_nodes.emplace_back(n, l);
+              if (!is_owned)
+                field.ghost_nodes.emplace_back(n, l);
             }
       // Owned nodes that other ranks also touch: their sums arrive through compress().
       for (const auto &range : partitioner.import_indices())
         for (unsigned int l = range.first; l < range.second; ++l)
           if (box_of_local[l] >= 0)
-            import_nodes.emplace_back(box_of_local[l], l);
-      std::sort(import_nodes.begin(), import_nodes.end());
-      import_nodes.erase(std::unique(import_nodes.begin(), import_nodes.end()), import_nodes.end());
+            field.import_nodes.emplace_back(box_of_local[l], l);
+      std::sort(field.import_nodes.begin(), field.import_nodes.end());
+      field.import_nodes.erase(std::unique(field.import_nodes.begin(), field.import_nodes.end()),
+                               field.import_nodes.end());
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::initialize_layer(const unsigned int n_blocks, const unsigned int block_size)
+    {
+      layer_blocks     = n_blocks;
+      layer_block_size = block_size;
+      layer.n_comp     = n_blocks * block_size;
+      if (n_ranks > 1)
+        connect(layer, false);
+      layer_nodes.assign(std::size_t(n_box_nodes) * layer.n_comp, 0.0);
     }
 
 
@@ -182,29 +216,55 @@ namespace hysteron
 
     template <int dim>
     void
-    BackgroundGrid<dim>::exchange(const unsigned int first, const unsigned int n)
+    BackgroundGrid<dim>::add_shared(Field             &field,
+                                    std::vector<double> &values,
+                                    const unsigned int   first,
+                                    const unsigned int   n,
+                                    const unsigned int   n_blocks,
+                                    const unsigned int   block_size)
     {
-      if (n_ranks == 1)
-        return;
       // Ghost entries carry this rank's contributions (only the exchanged
       // components are non-zero), owned shared entries this rank's own part;
       // compress() adds the ghosts into their owners, update_ghost_values()
-      // returns the sums.
-      buffer.zero_out_ghost_values();
-      for (const auto &[box, l] : ghost_nodes)
-        for (unsigned int c = first; c < first + n; ++c)
-          buffer.local_element(l + c) = nodes[std::size_t(box) * n_comp + c];
-      for (const auto &[box, l] : import_nodes)
-        for (unsigned int c = first; c < first + n; ++c)
-          buffer.local_element(l + c) = nodes[std::size_t(box) * n_comp + c];
-      buffer.compress(dealii::VectorOperation::add);
-      buffer.update_ghost_values();
-      for (const auto &[box, l] : import_nodes)
-        for (unsigned int c = first; c < first + n; ++c)
-          nodes[std::size_t(box) * n_comp + c] = buffer.local_element(l + c);
-      for (const auto &[box, l] : ghost_nodes)
-        for (unsigned int c = first; c < first + n; ++c)
-          nodes[std::size_t(box) * n_comp + c] = buffer.local_element(l + c);
+      // returns the sums. Components first + b * block_size + [0, n) of every
+      // block b are exchanged.
+      const unsigned int stride = field.n_comp;
+      const auto         copy   = [&](const auto &list, const bool to_buffer) {
+        for (const auto &[box, l] : list)
+          for (unsigned int b = 0; b < n_blocks; ++b)
+            for (unsigned int c = first + b * block_size; c < first + b * block_size + n; ++c)
+              if (to_buffer)
+                field.buffer.local_element(l + c) = values[std::size_t(box) * stride + c];
+              else
+                values[std::size_t(box) * stride + c] = field.buffer.local_element(l + c);
+      };
+      field.buffer.zero_out_ghost_values();
+      copy(field.ghost_nodes, true);
+      copy(field.import_nodes, true);
+      field.buffer.compress(dealii::VectorOperation::add);
+      field.buffer.update_ghost_values();
+      copy(field.import_nodes, false);
+      copy(field.ghost_nodes, false);
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::exchange(const unsigned int first, const unsigned int n)
+    {
+      if (n_ranks > 1)
+        add_shared(main, nodes, first, n, 1, n_comp);
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::exchange_layer(const unsigned int first, const unsigned int n)
+    {
+      if (n_ranks > 1)
+        add_shared(layer, layer_nodes, first, n, layer_blocks, layer_block_size);
     }
 
 
@@ -213,10 +273,23 @@ namespace hysteron
     void
     BackgroundGrid<dim>::zero_interface(const unsigned int first, const unsigned int n)
     {
-      for (const auto *list : {&ghost_nodes, &import_nodes})
+      for (const auto *list : {&main.ghost_nodes, &main.import_nodes})
         for (const auto &entry : *list)
           for (unsigned int c = first; c < first + n; ++c)
             nodes[std::size_t(entry.first) * n_comp + c] = 0.0;
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::zero_layer_interface(const unsigned int first, const unsigned int n)
+    {
+      for (const auto *list : {&layer.ghost_nodes, &layer.import_nodes})
+        for (const auto &entry : *list)
+          for (unsigned int b = 0; b < layer_blocks; ++b)
+            for (unsigned int c = first + b * layer_block_size; c < first + b * layer_block_size + n; ++c)
+              layer_nodes[std::size_t(entry.first) * layer.n_comp + c] = 0.0;
     }
 
 

@@ -171,6 +171,29 @@ namespace hysteron
       void
       exchange(const unsigned int first, const unsigned int n);
 
+      /**
+       * A second array of nodal data on the same nodes (the per-body fields of
+       * contact, source/mpm/contact.cc): @p n_blocks blocks of @p block_size
+       * doubles per node. Only allocated when asked for.
+       */
+      void
+      initialize_layer(const unsigned int n_blocks, const unsigned int block_size);
+
+      /// The layer's data: n_local_nodes() * n_blocks * block_size doubles.
+      std::vector<double> &
+      layer_data()
+      {
+        return layer_nodes;
+      }
+
+      /// exchange() for the components first + b * block_size + [0, n) of every block b of the layer.
+      void
+      exchange_layer(const unsigned int first, const unsigned int n);
+
+      /// zero_interface() for the layer (the components as in exchange_layer()).
+      void
+      zero_layer_interface(const unsigned int first, const unsigned int n);
+
       /// Set the components [first, first + n) of the interface nodes to zero
       /// (the nodes whose values exchange() may have changed without this rank
       /// touching them).
@@ -184,11 +207,38 @@ namespace hysteron
       }
 
     private:
+      /**
+       * The DoFs of one nodal array (n_comp FE_Q(1) per node) and, for the
+       * nodes shared with other ranks, (local box node, local vector index of
+       * component 0): what exchange() needs.
+       */
+      struct Field
+      {
+        unsigned int                                       n_comp = 0;
+        std::unique_ptr<dealii::FESystem<dim>>             fe;
+        dealii::DoFHandler<dim>                            dof_handler;
+        dealii::LinearAlgebra::distributed::Vector<double> buffer;
+        std::vector<std::pair<unsigned int, unsigned int>> ghost_nodes;
+        std::vector<std::pair<unsigned int, unsigned int>> import_nodes;
+      };
+
+      /// Distribute the field's DoFs and list its shared nodes (with @p set_node_flags
+      /// also which nodes are relevant and owned).
+      void
+      connect(Field &field, const bool set_node_flags);
+
+      /// Add up the blocks' components [first, first + n) of @p values at the shared nodes.
+      void
+      add_shared(Field               &field,
+                 std::vector<double> &values,
+                 const unsigned int   first,
+                 const unsigned int   n,
+                 const unsigned int   n_blocks,
+                 const unsigned int   block_size);
+
       MPI_Comm                                          comm;
       unsigned int                                      n_ranks;
       dealii::parallel::distributed::Triangulation<dim> tria;
-      std::unique_ptr<dealii::FESystem<dim>>            fe;
-      dealii::DoFHandler<dim>                           dof_handler;
       Lattice<dim>                                      grid_lattice;
       unsigned int                                      n_comp = 0;
 
@@ -203,12 +253,12 @@ namespace hysteron
       std::vector<unsigned char>    relevant_node;
       std::vector<unsigned char>    owned_node;
       std::vector<double>           nodes;
+      Field                         main;
 
-      /// Communication: the distributed vector and, for the nodes shared with
-      /// other ranks, (local box node, local vector index of component 0).
-      dealii::LinearAlgebra::distributed::Vector<double> buffer;
-      std::vector<std::pair<unsigned int, unsigned int>> ghost_nodes;
-      std::vector<std::pair<unsigned int, unsigned int>> import_nodes;
+      /// The optional second array (initialize_layer()).
+      std::vector<double> layer_nodes;
+      Field               layer;
+      unsigned int        layer_blocks = 0, layer_block_size = 0;
     };
   } // namespace MPM
 } // namespace hysteron

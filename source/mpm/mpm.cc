@@ -106,6 +106,33 @@ namespace hysteron
                           Patterns::Double(),
                           "A fixed `Time/Time step` larger than this multiple of the critical "
                           "step h / max_p(c_p + |v_p|) (eq. 4.47) stops the run, > 0.");
+        prm.enter_subsection("Contact");
+        {
+          prm.declare_entry("Enable",
+                            "false",
+                            Patterns::Bool(),
+                            "Contact between bodies on the grid (doc/mpm.md, 'Contact between "
+                            "bodies'): each body has its own nodal velocities where the nodal "
+                            "masses of two or more bodies overlap; bodies there do not "
+                            "interpenetrate, may separate and slide with Coulomb friction, and "
+                            "rigid bodies act on the material through contact (their reaction "
+                            "in reactions.csv) instead of prescribing the velocity of every grid "
+                            "node they touch. false: one velocity field for all bodies (bodies "
+                            "that meet move together, rigid bodies prescribe their nodes).");
+          prm.declare_entry("Friction coefficient",
+                            "0",
+                            Patterns::Double(),
+                            "Coulomb friction coefficient mu >= 0 [-] of every pair of bodies in "
+                            "contact (0: frictionless), unless `Pair friction coefficients` "
+                            "gives the pair its own.");
+          prm.declare_entry("Pair friction coefficients",
+                            "",
+                            Patterns::Anything(),
+                            "Friction coefficients [-] of particular pairs of bodies, "
+                            "'body, body: mu' separated by ';' (e.g. 'block, plate: 0.3; "
+                            "disk1, disk2: 0'); the other pairs take `Friction coefficient`.");
+        }
+        prm.leave_subsection();
         prm.declare_entry("Write particle table",
                           "false",
                           Patterns::Bool(),
@@ -170,6 +197,8 @@ namespace hysteron
         probe_interval  = scene.output_control().probe_interval;
         average_regions = scene.output_control().average_regions;
       }
+
+      parse_contact(prm);
 
       // The scene's bodies must lie in the grid.
       const auto &bodies = scene.body_descriptions();
@@ -346,14 +375,22 @@ namespace hysteron
         m_min = std::min(m_min, m);
       m_min      = dealii::Utilities::MPI::min(m_min, scene.mpi_communicator());
       small_mass = 1e-12 * m_min;
-      // The basis is chosen once: the phase kernels are templates of it.
-      phases = basis_name == "linear" ? make_step_phases<dim, Linear1D>(*this) :
-                                        make_step_phases<dim, CubicBSpline1D>(*this);
+      // The basis and contact are chosen once: the phase kernels are templates of them.
+      if (contact)
+        {
+          setup_contact();
+          phases = basis_name == "linear" ? make_step_phases<dim, Linear1D, true>(*this) :
+                                            make_step_phases<dim, CubicBSpline1D, true>(*this);
+        }
+      else
+        phases = basis_name == "linear" ? make_step_phases<dim, Linear1D, false>(*this) :
+                                          make_step_phases<dim, CubicBSpline1D, false>(*this);
 
       scene.console() << "mpm: " << n_global_particles << " material points, grid of ";
       for (unsigned int d = 0; d < dim; ++d)
         scene.console() << (d ? " x " : "") << n_cells[d];
-      scene.console() << " cells (h = " << cell_size << " m), " << basis_name << " basis" << std::endl;
+      scene.console() << " cells (h = " << cell_size << " m), " << basis_name << " basis"
+                      << (contact ? ", contact between bodies" : "") << std::endl;
     }
 
 

@@ -24,7 +24,7 @@ namespace hysteron
 {
   namespace MPM
   {
-    template <int dim, typename Basis>
+    template <int dim, typename Basis, bool with_contact>
     class PhaseKernels;
 
     /**
@@ -206,33 +206,64 @@ namespace hysteron
       needs_migration() const;
 
       // The phases of a step (StepPhases documents what each computes).
-      template <int, typename>
+      template <int, typename, bool>
       friend class PhaseKernels;
       /// Reset the nodes touched in the last step, the reactions and the loads at @p t.
       void
       begin_step(const double t);
-      template <typename Basis, bool with_forces>
+      template <typename Basis, bool with_forces, bool with_contact>
       void
       particles_to_grid();
-      template <typename Basis>
+      template <typename Basis, bool with_contact>
       void
       forces_to_grid(const bool updated_stresses);
       void
       nodal_velocities();
       void
       update_nodal_velocities(const double dt);
-      template <typename Basis>
+      template <typename Basis, bool with_contact>
       bool
       grid_to_particles(const double t, const double dt);
-      template <typename Basis>
+      template <typename Basis, bool with_contact>
       void
       remap_momenta();
       /// Strains, deformation gradients, volumes and stresses from the nodal
       /// velocities (with @p midpoint from v_i - Delta v_i / 2), with or without
       /// adding their work to internal_work.
-      template <typename Basis, bool midpoint>
+      template <typename Basis, bool midpoint, bool with_contact>
       bool
       update_stresses(const double dt, const bool record_work);
+
+      // Contact (`MPM/Contact`, contact.cc): every body has its own nodal mass,
+      // momentum, force and mass gradient in the grid's layer (block b of a node
+      // is body b: contact_block doubles, m, p or v, f or Delta v as in the common
+      // field, then the mass gradient and the velocity projected from the points);
+      // where two or more bodies have mass at a node their velocities are corrected
+      // so that they do not interpenetrate.
+      static constexpr unsigned int contact_block = 1 + 4 * dim;
+      bool                          contact       = false;
+      /// With contact: the blocks per node of the layer (one per body).
+      unsigned int                  n_contact_blocks = 0;
+      /// Coulomb friction coefficient of each pair of bodies (n_bodies x n_bodies).
+      std::vector<double>           friction;
+      /// Whether the layer holds momenta (after a transfer) or velocities.
+      bool                          layer_holds_momenta = true;
+      /// Whether the layer holds the momenta of particles_to_grid() (not yet converted).
+      bool                          layer_from_points = true;
+      /// Per local node: is it a node of a boundary condition (contact only).
+      std::vector<unsigned char>    contact_boundary_node;
+      /// Scratch of apply_contact(): per body, the trial and the rigid velocities.
+      std::vector<dealii::Tensor<1, dim>> contact_velocity, contact_rigid_velocity;
+      /// Allocate the layer and the scratch of contact (after setup_boundaries()).
+      void
+      setup_contact();
+      void
+      parse_contact(dealii::ParameterHandler &prm);
+      /// The per-body velocities at the active nodes from the common field (one body
+      /// at the node) or with the contact correction (two or more); with @p record
+      /// also Delta v per body and the reactions of rigid bodies.
+      void
+      apply_contact(const double t, const double dt, const bool record);
 
       /// Record the cell of point p at its new position @p x (or the failure).
       void
@@ -349,8 +380,9 @@ namespace hysteron
 
 
 
-    /// The phases of the step with the basis @p Basis (instantiated in step_linear.cc, step_cubic.cc).
-    template <int dim, typename Basis>
+    /// The phases of the step with the basis @p Basis, with or without contact
+    /// (instantiated in step_linear.cc, step_cubic.cc and their *_contact.cc).
+    template <int dim, typename Basis, bool with_contact>
     std::unique_ptr<StepPhases<dim>>
     make_step_phases(Solver<dim> &solver);
   } // namespace MPM

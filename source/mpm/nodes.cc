@@ -19,6 +19,14 @@ namespace hysteron
       for (const unsigned int n : active_nodes)
         std::memset(node + std::size_t(n) * C, 0, C * sizeof(double));
       grid->zero_interface(0, C);
+      if (contact)
+        {
+          const std::size_t L     = std::size_t(contact_block) * n_contact_blocks;
+          double *const     layer = grid->layer_data().data();
+          for (const unsigned int n : active_nodes)
+            std::memset(layer + n * L, 0, L * sizeof(double));
+          grid->zero_layer_interface(0, contact_block);
+        }
       for (const unsigned int n : rigid_nodes)
         rigid_node_body[n] = 0;
       active_nodes.clear();

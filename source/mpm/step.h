@@ -105,7 +105,7 @@ namespace hysteron
 
 
     template <int dim>
-    template <typename Basis, bool with_forces>
+    template <typename Basis, bool with_forces, bool with_contact>
     void
     Solver<dim>::particles_to_grid()
     {
@@ -114,9 +114,13 @@ namespace hysteron
 
       const internal::GridGeometry<dim> g(*grid);
       constexpr unsigned int C       = 1 + 2 * dim;
+      constexpr unsigned int K       = contact_block;
       double *const          node    = grid->data().data();
       const auto            &cur     = particles.current;
       const Tensor<1, dim>   gravity = this->get_scene().gravity();
+      // Contact: body b's block of node n is layer[n * L + b * K, ...).
+      double *const     layer = with_contact ? grid->layer_data().data() : nullptr;
+      const std::size_t L     = with_contact ? std::size_t(K) * n_contact_blocks : 0;
 
       for (const auto &group : particles.groups)
         {
@@ -135,17 +139,39 @@ namespace hysteron
                         node_stamp[n] = stamp;
                         active_nodes.push_back(n);
                       }
-                    if (group.material == nullptr && rigid_node_body[n] == 0)
-                      {
-                        rigid_node_body[n] = group.rigid_body + 1;
-                        rigid_nodes.push_back(n);
-                      }
+                    if constexpr (!with_contact)
+                      if (group.material == nullptr && rigid_node_body[n] == 0)
+                        {
+                          rigid_node_body[n] = group.rigid_body + 1;
+                          rigid_nodes.push_back(n);
+                        }
                   });
                 }
+              const double m = particles.mass[p];
               if (group.material == nullptr)
-                continue;
-              const double         m  = particles.mass[p];
+                {
+                  // Contact: a rigid body's mass and mass gradient give its share of the
+                  // contact normals (its velocity is prescribed).
+                  if constexpr (with_contact)
+                    {
+                      double *const block = layer + std::size_t(group.rigid_body) * K;
+                      const double  ms    = m / particles.thickness[p];
+                      support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
+                        double *const q = block + n * L;
+                        q[0] += N * m;
+                        for (unsigned int d = 0; d < dim; ++d)
+                          q[1 + 2 * dim + d] += ms * grad[d];
+                      });
+                    }
+                  continue;
+                }
               const Tensor<1, dim> mv = m * cur.v[p];
+              // Contact: the body's block, and the point's mass per unit thickness (2D) or
+              // per radian of ring (axisymmetric) for the mass gradient: the normal is that
+              // of the section, whatever the thickness or the radius.
+              double *const block =
+                with_contact ? layer + std::size_t(particles.body[p]) * K : nullptr;
+              const double ms = with_contact ? m / particles.thickness[p] : 0.0;
               if constexpr (with_forces)
                 {
                   // f_i += N_ip (m_p g + f_p) - V_p sigma_p grad N_ip (axisymmetric: and
@@ -164,25 +190,54 @@ namespace hysteron
                         r[1 + d] += N * mv[d];
                         r[1 + dim + d] += f[d];
                       }
+                    if constexpr (with_contact)
+                      {
+                        double *const q = block + n * L;
+                        q[0] += N * m;
+                        for (unsigned int d = 0; d < dim; ++d)
+                          {
+                            q[1 + d] += N * mv[d];
+                            q[1 + dim + d] += f[d];
+                            q[1 + 2 * dim + d] += ms * grad[d];
+                          }
+                      }
                   });
                 }
               else
-                support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &) {
+                support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
                   double *const r = node + std::size_t(n) * C;
                   r[0] += N * m;
                   for (unsigned int d = 0; d < dim; ++d)
                     r[1 + d] += N * mv[d];
+                  if constexpr (with_contact)
+                    {
+                      double *const q = block + n * L;
+                      q[0] += N * m;
+                      for (unsigned int d = 0; d < dim; ++d)
+                        {
+                          q[1 + d] += N * mv[d];
+                          q[1 + 2 * dim + d] += ms * grad[d];
+                        }
+                    }
+                  else
+                    (void)grad;
                 });
             }
         }
       grid->exchange(0, with_forces ? C : 1 + dim);
       nodes_hold_momenta = true;
+      if constexpr (with_contact)
+        {
+          grid->exchange_layer(0, K);
+          layer_holds_momenta = true;
+          layer_from_points   = true;
+        }
     }
 
 
 
     template <int dim>
-    template <typename Basis>
+    template <typename Basis, bool with_contact>
     void
     Solver<dim>::forces_to_grid(const bool updated_stresses)
     {
@@ -191,7 +246,10 @@ namespace hysteron
 
       const internal::GridGeometry<dim> g(*grid);
       constexpr unsigned int C       = 1 + 2 * dim;
+      constexpr unsigned int K       = contact_block;
       double *const          node    = grid->data().data();
+      double *const          layer   = with_contact ? grid->layer_data().data() : nullptr;
+      const std::size_t      L       = with_contact ? std::size_t(K) * n_contact_blocks : 0;
       const auto            &cur     = particles.current;
       const auto            &state   = updated_stresses ? particles.next : particles.current;
       const Tensor<1, dim>   gravity = this->get_scene().gravity();
@@ -209,21 +267,28 @@ namespace hysteron
                 if (dim == 2 && axisymmetric)
                   f_ext[0] -= hoop_force(group, p, state);
                 const SymmetricTensor<2, dim> vs = state.volume[p] * state.stress[p];
+                double *const                 block =
+                  with_contact ? layer + std::size_t(particles.body[p]) * K : nullptr;
                 support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
                   double *const        r = node + std::size_t(n) * C;
                   const Tensor<1, dim> f = N * f_ext - vs * grad;
                   for (unsigned int d = 0; d < dim; ++d)
                     r[1 + dim + d] += f[d];
+                  if constexpr (with_contact)
+                    for (unsigned int d = 0; d < dim; ++d)
+                      block[n * L + 1 + dim + d] += f[d];
                 });
               }
           }
       grid->exchange(1 + dim, dim);
+      if constexpr (with_contact)
+        grid->exchange_layer(1 + dim, dim);
     }
 
 
 
     template <int dim>
-    template <typename Basis>
+    template <typename Basis, bool with_contact>
     bool
     Solver<dim>::grid_to_particles(const double t, const double dt)
     {
@@ -231,8 +296,11 @@ namespace hysteron
       using Support = internal::Support<dim, Basis>;
 
       const internal::GridGeometry<dim> g(*grid);
+      // A point reads the nodes of the common field or, with contact, its body's block.
       constexpr unsigned int C       = 1 + 2 * dim;
-      const double *const    node    = grid->data().data();
+      constexpr unsigned int K       = contact_block;
+      const double *const    node    = with_contact ? grid->layer_data().data() : grid->data().data();
+      const std::size_t      stride  = with_contact ? std::size_t(K) * n_contact_blocks : C;
       const auto            &cur     = particles.current;
       auto                  &nxt     = particles.next;
       const Tensor<1, dim>   gravity = this->get_scene().gravity();
@@ -262,9 +330,10 @@ namespace hysteron
           for (unsigned int p = group.begin; p < group.end; ++p)
             {
               support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
-              Tensor<1, dim> v_pic, dv;
+              Tensor<1, dim>      v_pic, dv;
+              const double *const base = with_contact ? node + std::size_t(particles.body[p]) * K : node;
               support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &) {
-                const double *const r = node + std::size_t(n) * C;
+                const double *const r = base + n * stride;
                 for (unsigned int d = 0; d < dim; ++d)
                   {
                     v_pic[d] += N * r[1 + d];
@@ -298,7 +367,7 @@ namespace hysteron
 
 
     template <int dim>
-    template <typename Basis>
+    template <typename Basis, bool with_contact>
     void
     Solver<dim>::remap_momenta()
     {
@@ -312,10 +381,21 @@ namespace hysteron
       const auto            &nxt  = particles.next;
 
       // p_i = sum_p N_ip m_p v_p' (the masses m_i are those of the step's start).
+      constexpr unsigned int K     = contact_block;
+      double *const          layer = with_contact ? grid->layer_data().data() : nullptr;
+      const std::size_t      L     = with_contact ? std::size_t(K) * n_contact_blocks : 0;
       for (const unsigned int n : active_nodes)
         for (unsigned int d = 0; d < dim; ++d)
           node[std::size_t(n) * C + 1 + d] = 0.0;
       grid->zero_interface(1, dim);
+      if constexpr (with_contact)
+        {
+          for (const unsigned int n : active_nodes)
+            for (std::size_t b = 0; b < L; b += K)
+              for (unsigned int d = 0; d < dim; ++d)
+                layer[n * L + b + 1 + d] = 0.0;
+          grid->zero_layer_interface(1, dim);
+        }
       for (const auto &group : particles.groups)
         if (group.material != nullptr)
           {
@@ -324,21 +404,31 @@ namespace hysteron
               {
                 support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
                 const Tensor<1, dim> mv = particles.mass[p] * nxt.v[p];
+                double *const        block =
+                  with_contact ? layer + std::size_t(particles.body[p]) * K : nullptr;
                 support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &) {
                   double *const r = node + std::size_t(n) * C;
                   for (unsigned int d = 0; d < dim; ++d)
                     r[1 + d] += N * mv[d];
+                  if constexpr (with_contact)
+                    for (unsigned int d = 0; d < dim; ++d)
+                      block[n * L + 1 + d] += N * mv[d];
                 });
               }
           }
       grid->exchange(1, dim);
       nodes_hold_momenta = true;
+      if constexpr (with_contact)
+        {
+          grid->exchange_layer(1, dim);
+          layer_holds_momenta = true;
+        }
     }
 
 
 
     template <int dim>
-    template <typename Basis, bool midpoint>
+    template <typename Basis, bool midpoint, bool with_contact>
     bool
     Solver<dim>::update_stresses(const double dt, const bool record_work)
     {
@@ -346,8 +436,11 @@ namespace hysteron
       using Support = internal::Support<dim, Basis>;
 
       const internal::GridGeometry<dim> g(*grid);
-      constexpr unsigned int C    = 1 + 2 * dim;
-      const double *const node    = grid->data().data();
+      // A point reads the nodes of the common field or, with contact, its body's block.
+      constexpr unsigned int C      = 1 + 2 * dim;
+      constexpr unsigned int K      = contact_block;
+      const double *const    node   = with_contact ? grid->layer_data().data() : grid->data().data();
+      const std::size_t      stride = with_contact ? std::size_t(K) * n_contact_blocks : C;
       auto               &cur     = particles.current;
       auto               &nxt     = particles.next;
       const Tensor<2, dim> identity = unit_symmetric_tensor<dim>();
@@ -375,9 +468,11 @@ namespace hysteron
               for (unsigned int p = chunk; p < chunk_end; ++p)
                 {
                   support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
-                  Tensor<2, dim> L; // velocity gradient sum_i v_i (x) grad N_i
+                  Tensor<2, dim>      L; // velocity gradient sum_i v_i (x) grad N_i
+                  const double *const base =
+                    with_contact ? node + std::size_t(particles.body[p]) * K : node;
                   support.for_each(g.s1, g.s2, [&](const unsigned int n, double, const Tensor<1, dim> &grad) {
-                    const double *const r = node + std::size_t(n) * C;
+                    const double *const r = base + n * stride;
                     if constexpr (midpoint)
                       {
                         // v_i - Delta v_i / 2 = (v_i(t) + v_i(t + dt)) / 2
@@ -404,7 +499,7 @@ namespace hysteron
                       // the in-plane area (det(I + dt L)) and the radius (1 + d eps_tt).
                       double v_r = 0;
                       support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &) {
-                        const double *const r = node + std::size_t(n) * C;
+                        const double *const r = base + n * stride;
                         v_r += N * (midpoint ? r[1] - 0.5 * r[1 + dim] : r[1]);
                       });
                       const double hoop            = dt * v_r / cur.x[p][0];
@@ -478,7 +573,7 @@ namespace hysteron
      * each virtual function calls the solver's kernel of this basis (the
      * choice between kernels is one branch per phase and step).
      */
-    template <int dim, typename Basis>
+    template <int dim, typename Basis, bool with_contact>
     class PhaseKernels : public StepPhases<dim>
     {
     public:
@@ -490,15 +585,15 @@ namespace hysteron
       particles_to_grid(const bool forces) override
       {
         if (forces)
-          solver.template particles_to_grid<Basis, true>();
+          solver.template particles_to_grid<Basis, true, with_contact>();
         else
-          solver.template particles_to_grid<Basis, false>();
+          solver.template particles_to_grid<Basis, false, with_contact>();
       }
 
       void
       forces_to_grid(const typename StepPhases<dim>::Stress stress) override
       {
-        solver.template forces_to_grid<Basis>(stress == StepPhases<dim>::Stress::updated);
+        solver.template forces_to_grid<Basis, with_contact>(stress == StepPhases<dim>::Stress::updated);
       }
 
       void
@@ -522,27 +617,27 @@ namespace hysteron
       bool
       grid_to_particles(const double t, const double dt) override
       {
-        return solver.template grid_to_particles<Basis>(t, dt);
+        return solver.template grid_to_particles<Basis, with_contact>(t, dt);
       }
 
       void
       remap_momenta() override
       {
-        solver.template remap_momenta<Basis>();
+        solver.template remap_momenta<Basis, with_contact>();
       }
 
       bool
       update_stresses(const double dt, const typename StepPhases<dim>::Velocity velocity) override
       {
         return velocity == StepPhases<dim>::Velocity::midpoint ?
-                 solver.template update_stresses<Basis, true>(dt, true) :
-                 solver.template update_stresses<Basis, false>(dt, true);
+                 solver.template update_stresses<Basis, true, with_contact>(dt, true) :
+                 solver.template update_stresses<Basis, false, with_contact>(dt, true);
       }
 
       bool
       predict_stresses(const double dt) override
       {
-        return solver.template update_stresses<Basis, false>(dt, false);
+        return solver.template update_stresses<Basis, false, with_contact>(dt, false);
       }
 
     private:
@@ -551,11 +646,11 @@ namespace hysteron
 
 
 
-    template <int dim, typename Basis>
+    template <int dim, typename Basis, bool with_contact>
     std::unique_ptr<StepPhases<dim>>
     make_step_phases(Solver<dim> &solver)
     {
-      return std::make_unique<PhaseKernels<dim, Basis>>(solver);
+      return std::make_unique<PhaseKernels<dim, Basis, with_contact>>(solver);
     }
   } // namespace MPM
 } // namespace hysteron
