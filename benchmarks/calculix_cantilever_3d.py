@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """The 3D FEM against CalculiX on the same plastic cantilever, at equal meshes.
 
-    calculix_cantilever_3d.py --hysteron build/hysteron [--ccx ccx] [--workdir DIR]
-                              [--repeats 3] [--meshes 20x2x1,40x4x2] [--reference 80x8x4]
+    taskset -c 1 calculix_cantilever_3d.py --hysteron build/hysteron [--ccx ccx] [--workdir DIR]
+        [--out DIR] [--repeats 3] [--meshes 20x2x1,40x4x2] [--reference 80x8x4]
 
 The problem: a steel cantilever 1 m x 0.1 m x 0.05 m (x along the beam, y the depth, z the
 width), clamped at x = 0 (every node), its end face x = 1 m moved down by u_y = 30 mm in 20
@@ -22,9 +22,11 @@ Quantities: the end force F_y at the first increment (elastic: both codes model 
 material, so its difference is the discretisation's) and at 30 mm (the plastic plateau; the
 smooth Bouc-Wen knee and the bilinear one differ a little there). The reference of the elastic
 force is hysteron's Q2 on the finest mesh (--reference); error = |F - F_ref| / F_ref.
-Time = the wall time of the whole process (set-up, solve, output), both pinned to one core
-(taskset -c 1, OMP_NUM_THREADS=1), the median of --repeats runs. Writes DIR/results.json and
-prints a Markdown table (doc/benchmarks.md, "FEM against CalculiX").
+Time = the wall time of the whole process (set-up, solve, output), one thread each
+(OMP_NUM_THREADS=1 and CalculiX's CCX_NPROC_* = 1; run the script under taskset to pin both to
+one core, as benchmarks/make_report.py does), the median of --repeats runs. Writes
+WORKDIR/results.json, and the Markdown table to OUT/calculix_cantilever_3d.md (doc/benchmarks.md,
+"FEM against CalculiX") and to the standard output.
 """
 import argparse
 import json
@@ -168,13 +170,13 @@ def main():
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--meshes", default="20x2x1,40x4x2")
     parser.add_argument("--reference", default="80x8x4")
+    parser.add_argument("--out", default=None, help="directory of calculix_cantilever_3d.md")
     args = parser.parse_args()
     if shutil.which(args.ccx) is None:
         sys.exit(f"'{args.ccx}' not found: CalculiX is Debian's calculix-ccx (scripts/setup.sh installs it)")
     hysteron = os.path.abspath(args.hysteron)
     env = dict(os.environ, OMP_NUM_THREADS="1", CCX_NPROC_EQUATION_SOLVER="1",
                CCX_NPROC_STIFFNESS="1", CCX_NPROC_RESULTS="1")
-    pin = ["taskset", "-c", "1"] if shutil.which("taskset") and os.cpu_count() > 1 else []
     meshes = [tuple(map(int, m.split("x"))) for m in args.meshes.split(",")]
     reference = tuple(map(int, args.reference.split("x")))
     results = []
@@ -189,11 +191,11 @@ def main():
             if code == "hysteron":
                 with open(os.path.join(directory, "scene.prm"), "w") as f:
                     f.write(hysteron_scene(mesh[0], tolerance))
-                command = pin + [hysteron, "--quiet", "scene.prm"]
+                command = [hysteron, "--quiet", "scene.prm"]
             else:
                 with open(os.path.join(directory, "cantilever.inp"), "w") as f:
                     f.write(calculix_deck(*mesh))
-                command = pin + [args.ccx, "-i", "cantilever"]
+                command = [args.ccx, "-i", "cantilever"]
             repeats = 1 if mesh == reference else args.repeats
             times = [run_timed(command, directory, env) for _ in range(repeats)]
             first, last = (hysteron_forces if code == "hysteron" else calculix_forces)(directory)
@@ -205,17 +207,23 @@ def main():
     ref = next(r for r in results if r["code"] == "hysteron" and r["tolerance"] == 1e-8 and
                r["mesh"] == "x".join(map(str, reference)))
     with open(os.path.join(args.workdir, "results.json"), "w") as f:
-        json.dump(dict(results=results, reference=ref["mesh"], affinity=" ".join(pin) or "none"), f, indent=1)
-    print(f"\nreference: hysteron Q2 {ref['mesh']}, F(1.5 mm) = {ref['elastic_force']:.6e} N; "
-          f"pinned: {' '.join(pin) or 'no'}; median of {args.repeats} runs\n")
-    print("| code, element | Newton tolerance | mesh | run time [s] | F at 1.5 mm [N] | error | F at 30 mm [N] |")
-    print("|---|---|---|---:|---:|---:|---:|")
+        json.dump(dict(results=results, reference=ref["mesh"], affinity=sorted(os.sched_getaffinity(0))), f,
+                  indent=1)
+    lines = [f"reference: hysteron Q2 {ref['mesh']}, F(1.5 mm) = {ref['elastic_force']:.6e} N; cores "
+             f"{sorted(os.sched_getaffinity(0))}; median of {args.repeats} runs", "",
+             "| code, element | Newton tolerance | mesh | run time [s] | F at 1.5 mm [N] | error | F at 30 mm [N] |",
+             "|---|---|---|---:|---:|---:|---:|"]
     for r in results:
         element = "hysteron, Q2 + Bouc-Wen (n = 32)" if r["code"] == "hysteron" else "CalculiX 2.20, C3D20 + *PLASTIC"
         criterion = f"{r['tolerance']:g} of the force level" if r["tolerance"] else "default (0.5 % of the mean force)"
         error = abs(r["elastic_force"] - ref["elastic_force"]) / ref["elastic_force"]
-        print(f"| {element} | {criterion} | {r['mesh']} | {r['time']:.2f} | {r['elastic_force']:.6g} | "
-              f"{'reference' if r is ref else f'{error:.2e}'} | {r['plastic_force']:.6g} |")
+        lines.append(f"| {element} | {criterion} | {r['mesh']} | {r['time']:.2f} | {r['elastic_force']:.6g} | "
+                     f"{'reference' if r is ref else f'{error:.2e}'} | {r['plastic_force']:.6g} |")
+    print("\n" + "\n".join(lines))
+    if args.out:
+        os.makedirs(args.out, exist_ok=True)
+        with open(os.path.join(args.out, "calculix_cantilever_3d.md"), "w") as f:
+            f.write("\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ Studies (name: script; minutes on the 2-core Xeon VM with --repeats 3):
   mpm_scheme_time_step         vibrating bar: scheme x basis x h x CFL                       8
   fem_mpm_error_vs_time        elastic cantilever and §5.4 patch, FEM against MPM           25
   fem_plastic_error_vs_time    §5.1 plastic cantilever and §3.7.4 plate, FEM                  8
+  calculix_cantilever_3d       3D plastic cantilever, FEM against CalculiX 2.20 (C3D20)       8
   rbsn_run_time                RBSN cantilever / titanium plate against cells                 4
   rbsn_large                   RBSN 100k-cell elastic plate, 10k-cell plastic cantilever      6
   rbsn_incremental_assembly    RBSN tangent updated in place against assembled from zero       3
@@ -90,6 +91,10 @@ def studies(args, out, work):
         Study("fem_plastic_error_vs_time",
               py("fem_plastic_error_vs_time.py", "--repeats", r, "--out", out,
                  "--workdir", f"{work}/fem_plastic", *q), 8),
+        Study("calculix_cantilever_3d",
+              [PY, os.path.join(bench, "calculix_cantilever_3d.py"), "--hysteron", os.path.join(b, "hysteron"),
+               "--repeats", r, "--out", out, "--workdir", f"{work}/calculix"]
+              + (["--meshes", "20x2x1", "--reference", "40x4x2"] if args.quick else []), 8),
         Study("rbsn_run_time",
               py("rbsn_run_time.py", "--repeats", r, "--output", os.path.join(out, "rbsn_run_time"), *q), 4),
         Study("rbsn_large",

@@ -99,8 +99,9 @@ namespace hysteron
                           Patterns::Selection("small strain|Jaumann"),
                           "small strain: sigma += Delta sigma(d eps) (eq. 4.41); Jaumann: the "
                           "stress is also rotated with the spin, sigma += (W sigma - sigma W) dt "
-                          "(objective; for large rotations). Internal tensors of the material "
-                          "(back stress) are not rotated.");
+                          "(objective; for large rotations); the material's tensor state (plastic "
+                          "strain, back stress) turns with it. The FEM's counterpart is "
+                          "FEM/Kinematics = updated Lagrangian.");
         prm.declare_entry("Maximum CFL number",
                           "1",
                           Patterns::Double(),

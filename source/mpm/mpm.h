@@ -316,6 +316,8 @@ namespace hysteron
       std::vector<dealii::SymmetricTensor<2, dim>> strain_increment =
         std::vector<dealii::SymmetricTensor<2, dim>>(stress_chunk);
       std::vector<double> hoop_increment = std::vector<double>(stress_chunk); ///< axisymmetric
+      /// Jaumann: the rotation of each point's tensor state over the step (of one chunk).
+      std::vector<dealii::Tensor<2, dim>> state_rotation = std::vector<dealii::Tensor<2, dim>>(stress_chunk);
 
       /// Axisymmetric: the hoop stress sigma_tt of point p (of a deformable group) in @p state.
       double

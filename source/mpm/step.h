@@ -515,6 +515,9 @@ namespace hysteron
                       const Tensor<2, dim> W = 0.5 * dt * (L - transpose(L));
                       const Tensor<2, dim> s = cur.stress[p];
                       nxt.stress[p]          = symmetrize(W * s - s * W) + cur.stress[p];
+                      // The material's tensor state (plastic strain, back stress) turns with
+                      // the stress, by the orthogonal (I - W/2)^{-1} (I + W/2) = I + W + O(W^2).
+                      state_rotation[p - chunk] = invert(identity - 0.5 * W) * (identity + 0.5 * W);
                     }
                   else
                     nxt.stress[p] = cur.stress[p];
@@ -526,6 +529,12 @@ namespace hysteron
                 std::memcpy(nxt.material_state.data() + offset,
                             cur.material_state.data() + offset,
                             n_state * sizeof(double));
+              if (jaumann && group.n_state > 0)
+                for (unsigned int p = chunk; p < chunk_end; ++p)
+                  group.material->rotate_state(state_rotation[p - chunk],
+                                               ArrayView<double>(nxt.material_state.data() + offset +
+                                                                   std::size_t(p - chunk) * group.n_state,
+                                                                 group.n_state));
               if (axisymmetric)
                 group.material->update_axisymmetric(view(strain_increment.data(), n_points),
                                                     view(hoop_increment.data(), n_points),
