@@ -370,14 +370,16 @@ namespace hysteron
                     out.message = m.str();
                     return;
                   }
-                const Tensor<2, dim> inv0T = transpose(invert(F0)), inv1T = transpose(invert(F1)),
-                                     invmT = transpose(invert(Fm));
+                // The converged configuration only serves f_int(u_n) of HHT-alpha.
+                const Tensor<2, dim> inv0T = dynamic ? transpose(invert(F0)) : Tensor<2, dim>(),
+                                     inv1T = transpose(invert(F1)), invmT = transpose(invert(Fm));
                 for (unsigned int i = 0; i < n; ++i)
                   {
                     const Tensor<1, dim> &g = fv.shape_grad(i, q);
                     scratch.Gs[q][i] = invmT * g;
                     scratch.Gf[q][i] = inv1T * g;
-                    scratch.G0[q][i] = inv0T * g;
+                    if (dynamic)
+                      scratch.G0[q][i] = inv0T * g;
                     B[q][i]          = component_gradient(comp[i], scratch.Gs[q][i]);
                     if (b_bar)
                       scratch.Bf[q][i] = component_gradient(comp[i], scratch.Gf[q][i]);

@@ -4,8 +4,14 @@ ASCII format 2.2, with named physical groups (what Gmsh writes for a .geo with
 Physical Curve("left") = ...; Physical Surface("bar") = ...):
   1 "left"  (dimension 1): the edge x = 0      2 "right" (dimension 1): the edge x = 1
   4 "top"   (dimension 1): the edge y = 0.1    3 "bar"   (dimension 2): every cell
-Run: python3 make_bar_groups.py > bar_groups.msh"""
+With --triangles, bar_groups_triangles.msh: each square split into two triangles along
+alternating diagonals (80 triangles), the same nodes and groups.
+Run: python3 make_bar_groups.py > bar_groups.msh
+     python3 make_bar_groups.py --triangles > bar_groups_triangles.msh"""
+import sys
+
 nx, ny, L, H = 20, 2, 1.0, 0.1
+triangles = "--triangles" in sys.argv[1:]
 
 
 def node(i, j):
@@ -27,7 +33,13 @@ for i in range(nx):  # top edge (physical 4, elementary 3)
     elements.append(f"1 2 4 3 {node(i, ny)} {node(i + 1, ny)}")
 for j in range(ny):
     for i in range(nx):
-        elements.append(f"3 2 3 1 {node(i, j)} {node(i + 1, j)} {node(i + 1, j + 1)} {node(i, j + 1)}")
+        a, b, c, d = node(i, j), node(i + 1, j), node(i + 1, j + 1), node(i, j + 1)
+        if not triangles:
+            elements.append(f"3 2 3 1 {a} {b} {c} {d}")
+        elif (i + j) % 2 == 0:  # diagonal a-c
+            elements += [f"2 2 3 1 {a} {b} {c}", f"2 2 3 1 {a} {c} {d}"]
+        else:  # diagonal b-d
+            elements += [f"2 2 3 1 {a} {b} {d}", f"2 2 3 1 {b} {c} {d}"]
 lines += ["$Elements", str(len(elements))]
 lines += [f"{k + 1} {e}" for k, e in enumerate(elements)]
 lines.append("$EndElements")
