@@ -15,13 +15,14 @@
  *
  * <h3>Grid</h3>
  * The background grid is a Cartesian lattice with origin @f$\mathbf o@f$,
- * uniform cell size @f$h@f$ and @f$n_d@f$ cells in direction @f$d@f$; node
+ * cell size @f$h_d@f$ and @f$n_d@f$ cells in direction @f$d@f$ (all @f$h_d@f$
+ * equal unless the grid moves and stretches); node
  * @f$(i_0,\dots,i_{dim-1})@f$, @f$0\le i_d\le n_d@f$, sits at
- * @f$\mathbf o + h\,\mathbf i@f$ and has the lattice-lexicographic number
+ * @f$o_d + h_d\,i_d@f$ and has the lattice-lexicographic number
  * @f$i_0 + (n_0+1)\,(i_1 + (n_1+1)\,i_2)@f$. All 1D kernels work in the
- * lattice coordinate @f$\xi = (x - o_d)/h \in [0, n_d]@f$; the basis of the
+ * lattice coordinate @f$\xi = (x - o_d)/h_d \in [0, n_d]@f$; the basis of the
  * grid is the tensor product @f$N_{\mathbf i}(\mathbf x) = \prod_d
- * N_{i_d}(\xi_d)@f$, with @f$\partial N/\partial x_d = h^{-1}\,\partial
+ * N_{i_d}(\xi_d)@f$, with @f$\partial N/\partial x_d = h_d^{-1}\,\partial
  * N/\partial \xi_d@f$.
  *
  * <h3>Linear basis</h3>
@@ -126,6 +127,18 @@ namespace hysteron
 
 
 
+    /// The cell sizes of a lattice of square (cubic) cells of size @p h.
+    template <int dim>
+    std::array<double, dim>
+    uniform_h(const double h)
+    {
+      std::array<double, dim> a;
+      a.fill(h);
+      return a;
+    }
+
+
+
     /**
      * The Cartesian background lattice: @p n_cells[d] cells of size @p h in
      * direction @p d starting at @p origin; nodes 0..n_cells[d] per direction.
@@ -134,8 +147,38 @@ namespace hysteron
     struct Lattice
     {
       dealii::Point<dim>              origin;
-      double                          h = 1.;
+      /// The cell size of each direction: all equal at set-up; a moving grid
+      /// (`MPM/Grid/Motion`) stretches each direction on its own.
+      std::array<double, dim>         h{};
       std::array<unsigned int, dim> n_cells{};
+
+      /// The smallest cell size (of the critical time step).
+      double
+      min_h() const
+      {
+        return *std::min_element(h.begin(), h.end());
+      }
+
+      /// The upper corner origin + n_cells h.
+      dealii::Point<dim>
+      upper() const
+      {
+        dealii::Point<dim> p = origin;
+        for (unsigned int d = 0; d < dim; ++d)
+          p[d] += n_cells[d] * h[d];
+        return p;
+      }
+
+      /// The lattice coordinate (x_d - o_d) / h_d of @p x minus @p cell: the point's
+      /// coordinates in its unit cell (the reference location of a particle).
+      dealii::Point<dim>
+      unit_cell_point(const dealii::Point<dim> &x, const std::array<unsigned int, dim> &cell) const
+      {
+        dealii::Point<dim> r;
+        for (unsigned int d = 0; d < dim; ++d)
+          r[d] = (x[d] - origin[d]) / h[d] - cell[d];
+        return r;
+      }
 
       /**
        * Multi-index of the cell containing @p x. A point on an upper face of
@@ -146,9 +189,8 @@ namespace hysteron
       cell_of(const dealii::Point<dim> &x) const
       {
         std::array<unsigned int, dim> cell;
-        const double                  inv_h = 1. / h;
         for (unsigned int d = 0; d < dim; ++d)
-          cell[d] = clamped_cell((x[d] - origin[d]) * inv_h, n_cells[d]);
+          cell[d] = clamped_cell((x[d] - origin[d]) * (1. / h[d]), n_cells[d]);
         return cell;
       }
 
@@ -159,7 +201,7 @@ namespace hysteron
       contains(const dealii::Point<dim> &x) const
       {
         for (unsigned int d = 0; d < dim; ++d)
-          if (x[d] < origin[d] || x[d] > origin[d] + n_cells[d] * h)
+          if (x[d] < origin[d] || x[d] > origin[d] + n_cells[d] * h[d])
             return false;
         return true;
       }
@@ -211,7 +253,7 @@ namespace hysteron
       }
 
       /**
-       * Position origin + h i of the node with number @p node.
+       * Position origin + (h_d i_d) of the node with number @p node.
        */
       dealii::Point<dim>
       node_location(const unsigned int node) const
@@ -219,7 +261,7 @@ namespace hysteron
         const auto         index = node_index(node);
         dealii::Point<dim> p     = origin;
         for (unsigned int d = 0; d < dim; ++d)
-          p[d] += h * index[d];
+          p[d] += h[d] * index[d];
         return p;
       }
 
@@ -437,7 +479,7 @@ namespace hysteron
 
     /**
      * Evaluate the tensor-product basis at @p x into @p out: per direction
-     * one 1D kernel call on xi_d = (x_d - o_d)/h, then
+     * one 1D kernel call on xi_d = (x_d - o_d)/h_d, then
      * N_k = prod_d N^d_{k_d}, (grad N_k)_d = h^{-1} dN^d_{k_d}/dxi prod_{e!=d} N^e_{k_e}.
      * No allocation, no virtual call.
      */
@@ -451,9 +493,9 @@ namespace hysteron
       constexpr unsigned int m = Basis1D::n_support;
       double                 v[dim][m];
       double                 dv[dim][m];
-      const double           inv_h = 1. / lattice.h;
       for (unsigned int d = 0; d < dim; ++d)
         {
+          const double inv_h = 1. / lattice.h[d];
           Basis1D::evaluate((x[d] - lattice.origin[d]) * inv_h,
                             lattice.n_cells[d],
                             out.first[d],

@@ -4,6 +4,8 @@
 #include "mpm/mpm.h"
 
 #include <algorithm>
+#include <cmath>
+#include <utility>
 
 namespace hysteron
 {
@@ -56,6 +58,15 @@ namespace hysteron
       out.put(n_changed_cells);
       out.put(n_rebuilds);
       tables.save(out);
+      if (grid_moves)
+        {
+          // Where the grid is (a checkpoint of a fixed grid has no such section).
+          out.section("mpm grid motion");
+          const Lattice<dim> &lattice = grid->lattice();
+          out.put(std::vector<double>(&lattice.origin[0], &lattice.origin[0] + dim));
+          out.put(std::vector<double>(lattice.h.begin(), lattice.h.end()));
+          out.put(grid_table_time);
+        }
     }
 
 
@@ -121,6 +132,25 @@ namespace hysteron
       in.get(n_changed_cells);
       in.get(n_rebuilds);
       tables.load(in);
+      if (grid_moves)
+        {
+          in.section("mpm grid motion");
+          std::vector<double> origin, h;
+          in.get(origin);
+          in.get(h);
+          in.get(grid_table_time);
+          if (origin.size() != dim || h.size() != dim)
+            in.refuse("the moving grid's corner or cell sizes have the wrong dimension");
+          Lattice<dim> moved = grid->lattice();
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              if (!(h[d] > 0) || !std::isfinite(origin[d]))
+                in.refuse("the moving grid's corner or cell sizes are not valid");
+              moved.origin[d] = origin[d];
+              moved.h[d]      = h[d];
+            }
+          grid->move(moved);
+        }
 
       // The ParticleHandler holds the same points (identity, owner, output): it is
       // refilled from the arrays, and handler_index maps its order to theirs.
@@ -142,11 +172,7 @@ namespace hysteron
           properties[PI::mass]      = P.mass[s];
           properties[PI::volume0]   = P.volume0[s];
           properties[PI::thickness] = P.thickness[s];
-          Point<dim> reference;
-          for (unsigned int d = 0; d < dim; ++d)
-            reference[d] = (x[d] - lattice.origin[d]) / lattice.h - cell[d];
-          handler->insert_particle(x, reference, P.id[s], grid->cell_iterator(cid),
-                                   make_array_view(properties));
+          insert_into_handler(x, P.id[s], make_array_view(std::as_const(properties)));
         }
       handler->update_cached_numbers();
       std::vector<std::pair<types::particle_index, unsigned int>> by_id(n);

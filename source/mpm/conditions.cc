@@ -42,7 +42,7 @@ namespace hysteron
                     }
                 }
               if (description.has_region &&
-                  description.region.contains(grid->node_position(n), 1e-9 * lattice.h))
+                  description.region.contains(grid->node_position(n), 1e-9 * cell_size))
                 {
                   b.nodes.push_back(n);
                   b.normal_direction.push_back(0);
@@ -68,10 +68,10 @@ namespace hysteron
     Solver<dim>::grid_extent() const
     {
       const auto        &lattice = grid->lattice();
+      const auto         upper   = lattice.upper();
       std::ostringstream s;
       for (unsigned int d = 0; d < dim; ++d)
-        s << (d > 0 ? " x [" : "[") << lattice.origin[d] << ", "
-          << lattice.origin[d] + lattice.n_cells[d] * lattice.h << "]";
+        s << (d > 0 ? " x [" : "[") << lattice.origin[d] << ", " << upper[d] << "]";
       return s.str();
     }
 

@@ -32,8 +32,9 @@ namespace hysteron
     {
       using namespace dealii;
       grid_lattice.origin  = lower;
-      grid_lattice.h       = h;
+      grid_lattice.h       = uniform_h<dim>(h);
       grid_lattice.n_cells = n_cells;
+      initial_lattice      = grid_lattice;
       n_comp               = n_components;
 
       std::vector<unsigned int> repetitions(n_cells.begin(), n_cells.end());
@@ -123,8 +124,9 @@ namespace hysteron
       std::vector<unsigned char> seen(n_box_nodes, 0);
       field.ghost_nodes.clear();
       field.import_nodes.clear();
-      const Point<dim> &lower = grid_lattice.origin;
-      const double      h     = grid_lattice.h;
+      // The triangulation keeps the geometry of the set-up.
+      const Point<dim> &lower = initial_lattice.origin;
+      const double      h     = initial_lattice.h[0];
       for (const auto &cell : field.dof_handler.active_cell_iterators())
         if (!cell->is_artificial())
           for (const unsigned int v : cell->vertex_indices())
@@ -208,7 +210,7 @@ namespace hysteron
       const auto         i = lattice_index(n);
       dealii::Point<dim> x = grid_lattice.origin;
       for (unsigned int d = 0; d < dim; ++d)
-        x[d] += i[d] * grid_lattice.h;
+        x[d] += i[d] * grid_lattice.h[d];
       return x;
     }
 

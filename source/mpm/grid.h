@@ -52,10 +52,54 @@ namespace hysteron
                  const unsigned int                    n_components,
                  const std::vector<unsigned int>      &work_per_cell = {});
 
+      /// The lattice of the current step (moved by move() if the grid moves).
       const Lattice<dim> &
       lattice() const
       {
         return grid_lattice;
+      }
+
+      /// The lattice of the set-up: the geometry of the triangulation, and so the
+      /// frame in which the ParticleHandler holds the points' locations.
+      const Lattice<dim> &
+      initial_lattice_geometry() const
+      {
+        return initial_lattice;
+      }
+
+      /**
+       * Move the grid (`MPM/Grid/Motion`): the same cells and nodes, with a new
+       * lower corner and new cell sizes. Only the lattice moves; the
+       * triangulation keeps the set-up's geometry, and to_initial_frame() maps a
+       * position to where the same lattice coordinates lie there.
+       */
+      void
+      move(const Lattice<dim> &moved)
+      {
+        grid_lattice = moved;
+      }
+
+      /// The position with the same lattice coordinates in the set-up's lattice:
+      /// o0 + h0 (x - o) / h per direction (the identity while the grid has not moved).
+      dealii::Point<dim>
+      to_initial_frame(const dealii::Point<dim> &x) const
+      {
+        dealii::Point<dim> y;
+        for (unsigned int d = 0; d < dim; ++d)
+          y[d] = initial_lattice.origin[d] +
+                 (x[d] - grid_lattice.origin[d]) * (initial_lattice.h[d] / grid_lattice.h[d]);
+        return y;
+      }
+
+      /// The inverse of to_initial_frame().
+      dealii::Point<dim>
+      from_initial_frame(const dealii::Point<dim> &y) const
+      {
+        dealii::Point<dim> x;
+        for (unsigned int d = 0; d < dim; ++d)
+          x[d] = grid_lattice.origin[d] +
+                 (y[d] - initial_lattice.origin[d]) * (grid_lattice.h[d] / initial_lattice.h[d]);
+        return x;
       }
 
       const dealii::parallel::distributed::Triangulation<dim> &
@@ -239,7 +283,7 @@ namespace hysteron
       MPI_Comm                                          comm;
       unsigned int                                      n_ranks;
       dealii::parallel::distributed::Triangulation<dim> tria;
-      Lattice<dim>                                      grid_lattice;
+      Lattice<dim>                                      grid_lattice, initial_lattice;
       unsigned int                                      n_comp = 0;
 
       /// Per lattice cell: owned (1) or not (0); the triangulation index of the cell.

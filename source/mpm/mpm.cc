@@ -72,6 +72,7 @@ namespace hysteron
                             "0.1",
                             Patterns::Double(),
                             "Edge length h of the square (cubic) grid cells [m], > 0.");
+          declare_grid_motion_parameters(prm);
         }
         prm.leave_subsection();
         prm.declare_entry("Basis",
@@ -179,6 +180,7 @@ namespace hysteron
                 "the grid would have " + std::to_string(n_total) + " cells (at most 2e8)");
       }
       {
+        parse_grid_motion(prm);
         Section s(prm, {"MPM"});
         basis_name = s.get("Basis");
         if (basis_name == "cubic B-spline")
@@ -276,7 +278,7 @@ namespace hysteron
       const double speed = grid->is_parallel() ?
                              dealii::Utilities::MPI::max(max_speed, grid->mpi_communicator()) :
                              max_speed;
-      return speed > 0 ? cell_size / speed : std::numeric_limits<double>::max();
+      return speed > 0 ? grid->lattice().min_h() / speed : std::numeric_limits<double>::max();
     }
 
 
@@ -301,10 +303,21 @@ namespace hysteron
             << this->n_steps() + 1 << "): material point " << particles.id[s] << " of body '"
             << this->get_scene().body_descriptions()[particles.body[s]].name << "' at "
             << format_point(x, dim);
+          const auto &lattice = grid->lattice();
+          const auto  top     = lattice.upper();
           if (failure == "a material point left the grid")
             m << " moved to " << format_point(x_new, dim) << " (grid from "
-              << format_point(&lower[0], dim) << " to " << format_point(&upper[0], dim)
+              << format_point(&lattice.origin[0], dim) << " to " << format_point(&top[0], dim)
               << "; enlarge MPM/Grid or check the loads and boundary conditions)";
+          else if (failure == "a material point left the moving grid")
+            m << " moved to " << format_point(x_new, dim) << ", outside the grid as it moved in the step (to "
+              << moved_extent << "; "
+              << (grid_motion == GridMotion::follow ?
+                    "the grid follows the affine part of the followed bodies' motion, which a body "
+                    "that is not followed, or one that deforms far from affinely (an impact), can "
+                    "leave: enlarge MPM/Grid, follow only the translation (MPM/Grid/Motion/Stretch "
+                    "= false) or keep the grid fixed)" :
+                    "enlarge MPM/Grid or change MPM/Grid/Motion/Velocity and Stretch rate)");
           if (step_dt > step_critical)
             m << "; the fixed time step " << step_dt << " s is " << step_dt / step_critical
               << " times the critical step " << step_critical
@@ -370,6 +383,7 @@ namespace hysteron
       generate_particles();
       from_handler();
       setup_boundaries();
+      setup_grid_motion();
       // The smallest mass a node may have and still get a velocity.
       double m_min = std::numeric_limits<double>::max();
       for (const double m : particles.mass)
@@ -391,7 +405,11 @@ namespace hysteron
       for (unsigned int d = 0; d < dim; ++d)
         scene.console() << (d ? " x " : "") << n_cells[d];
       scene.console() << " cells (h = " << cell_size << " m), " << basis_name << " basis"
-                      << (contact ? ", contact between bodies" : "") << std::endl;
+                      << (contact ? ", contact between bodies" : "")
+                      << (grid_motion == GridMotion::follow ?
+                            ", the grid follows the bodies" :
+                            grid_motion == GridMotion::prescribed ? ", the grid moves as prescribed" : "")
+                      << std::endl;
     }
 
 
@@ -401,6 +419,15 @@ namespace hysteron
     Solver<dim>::open_outputs()
     {
       open_tables();
+      if (grid_moves && this->get_scene().is_root())
+        {
+          std::vector<std::string> columns{"time"};
+          for (unsigned int d = 0; d < dim; ++d)
+            columns.push_back(std::string("lower_") + component_suffix[d]);
+          for (unsigned int d = 0; d < dim; ++d)
+            columns.push_back(std::string("h_") + component_suffix[d]);
+          grid_table = std::make_unique<Output::TimeTable>(this->output_file("grid.csv"), columns);
+        }
     }
 
 
@@ -465,6 +492,11 @@ namespace hysteron
       };
       begin_step(t);
       update_scheme->step(*phases, t, dt);
+      // A moving grid: where it is after the step (collective, so before any decision).
+      Lattice<dim> moved;
+      if (grid_moves)
+        if (const std::string refused = moved_lattice(t, dt, moved); !refused.empty())
+          fail_at_t(refused);
       bool failed = failed_point >= 0;
       if (grid->is_parallel())
         failed = dealii::Utilities::MPI::logical_or(failed, grid->mpi_communicator());
@@ -474,6 +506,8 @@ namespace hysteron
         fail_at_t(diverged);
       particles.commit();
       t += dt;
+      if (grid_moves)
+        move_grid(moved);
 
       // Points that left this rank's cells go to their new owner; many cell
       // changes restore the cell order of the arrays (locality).

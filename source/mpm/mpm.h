@@ -114,6 +114,8 @@ namespace hysteron
       write_rows(double t) override
       {
         write_table_rows(t);
+        if (grid_moves)
+          write_grid_row(t);
       }
       void
       write_fields(double t, Output::FieldWriter &writer) override;
@@ -160,6 +162,51 @@ namespace hysteron
       std::vector<Geometry::Region<dim>> average_regions;
       double                        small_mass = 0; ///< nodes lighter than this have no velocity
 
+      // The moving grid (`MPM/Grid/Motion`, grid_motion.cc). The lattice is moved
+      // after every step; the kernels see only the lattice of their step.
+      enum class GridMotion
+      {
+        fixed,     ///< the grid stays where it is
+        follow,    ///< the grid follows the affine part of the motion of some bodies
+        prescribed ///< the lower corner moves and the cells stretch as functions of t
+      };
+      GridMotion                                   grid_motion = GridMotion::fixed;
+      /// Whether the grid moves (any Type but fixed): a fixed grid pays nothing.
+      bool                                         grid_moves = false;
+      /// follow: per body, whether its points are followed; whether the cells stretch.
+      std::vector<bool>                            motion_follows_body;
+      bool                                         motion_stretches = true;
+      /// prescribed: the lower corner's velocity [m/s] and the stretch rates d ln h_d / dt [1/s].
+      std::shared_ptr<dealii::FunctionParser<1>>   motion_velocity, motion_stretch_rate;
+      /// follow: per face 2 d + side, the boundary condition that holds the face in
+      /// its normal direction (its index), or -1: a held face moves only as the
+      /// condition moves the material there.
+      std::array<int, 2 * dim>                     held_face;
+      /// The grid's lower corner and cell sizes at the rows of grid.csv (rank 0).
+      std::unique_ptr<Output::TimeTable>           grid_table;
+      double                                       grid_table_time = -1;
+      /// "[x0, x1] x [y0, y1]" of the lattice moved_lattice() computed last (messages).
+      std::string                                  moved_extent;
+      static void
+      declare_grid_motion_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_grid_motion(dealii::ParameterHandler &prm);
+      /// After setup_boundaries(): which faces of the grid the conditions hold.
+      void
+      setup_grid_motion();
+      /**
+       * The lattice after the step from @p t to @p t + @p dt (points at
+       * particles.next), collective. Sets failed_point if a point lies outside
+       * it; returns a message (the same on every rank) if the grid cannot move so.
+       */
+      std::string
+      moved_lattice(const double t, const double dt, Lattice<dim> &moved);
+      /// Move the grid to @p moved and find the points' cells in it (after commit()).
+      void
+      move_grid(const Lattice<dim> &moved);
+      void
+      write_grid_row(const double t);
+
       // Set-up and the pieces of run().
       void
       setup_grid();
@@ -175,8 +222,15 @@ namespace hysteron
       warn_about_idle_boundaries() const;
       void
       from_handler();
+      /// Copy the arrays into the handler; the locations in the set-up's frame of a
+      /// moving grid (for sorting), or with @p physical_locations where they are (output).
       void
-      to_handler();
+      to_handler(const bool physical_locations = false);
+      /// Put a new point at @p x (in the current lattice, a cell of this rank) into the handler.
+      void
+      insert_into_handler(const dealii::Point<dim>               &x,
+                          const dealii::types::particle_index     id,
+                          const dealii::ArrayView<const double>  &properties);
       void
       locate_probes();
       double
@@ -273,7 +327,9 @@ namespace hysteron
         bool                finite  = true;
         for (unsigned int d = 0; d < dim; ++d)
           finite = finite && std::isfinite(x[d]);
-        if (!finite || !lattice.contains(x))
+        // A moving grid checks the points against the lattice of the next step
+        // (moved_lattice()); here it only finds their cells in this one.
+        if (!finite || (!grid_moves && !lattice.contains(x)))
           {
             if (failed_point < 0)
               {

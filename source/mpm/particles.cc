@@ -11,6 +11,7 @@
 #include <functional>
 #include <numeric>
 #include <sstream>
+#include <utility>
 
 namespace hysteron
 {
@@ -32,7 +33,7 @@ namespace hysteron
       // weigh the cells when p4est partitions them, so that ranks get equal work.
       Lattice<dim> lattice;
       lattice.origin  = lower;
-      lattice.h       = cell_size;
+      lattice.h       = uniform_h<dim>(cell_size);
       lattice.n_cells = n_cells;
       const Geometry::FillLattice<dim> fill_lattice{lower, cell_size, n_cells};
       std::vector<unsigned int>        points_per_cell;
@@ -143,7 +144,7 @@ namespace hysteron
           const auto  &group     = group_templates[group_of_body[b]];
           // The point's share of the body: its sub-cell times the thickness there (2D;
           // axisymmetric: times the circumference 2 pi r).
-          const double cell_volume = std::pow(lattice.h / body.particles_per_cell, dim);
+          const double cell_volume = std::pow(cell_size / body.particles_per_cell, dim);
           const double density =
             scene.material(body.material, "Body " + body.name + "/Material").density();
           for (const auto &x : points)
@@ -152,7 +153,7 @@ namespace hysteron
               unsigned int                load = 0;
               if (!body.rigid)
                 for (unsigned int l = 0; l < loads.size() && load == 0; ++l)
-                  if (loads[l].region.contains(x, 1e-9 * lattice.h))
+                  if (loads[l].region.contains(x, 1e-9 * cell_size))
                     load = l + 1;
               // On every rank (the same error everywhere if it is not > 0).
               // Axisymmetric: the ring around the axis, 2 pi r per unit of section area.
@@ -193,22 +194,19 @@ namespace hysteron
               if (group.material != nullptr && group.n_state > 0)
                 group.material->initialize_state(
                   view(properties.data() + PI::n_fixed, group.n_state));
-              Point<dim> reference;
-              for (unsigned int d = 0; d < dim; ++d)
-                reference[d] = (x[d] - lattice.origin[d]) / lattice.h - cell[d];
-              handler->insert_particle(x, reference, id, grid->cell_iterator(cid), make_array_view(properties));
+              insert_into_handler(x, id, make_array_view(std::as_const(properties)));
             }
         }
       // A probe follows its nearest material point; a point farther than a grid
       // cell diagonal from every one of them lies outside the deformable bodies.
       for (unsigned int i = 0; i < probes.size(); ++i)
-        if (!(best_distance[i] <= std::sqrt(double(dim)) * lattice.h))
+        if (!(best_distance[i] <= std::sqrt(double(dim)) * cell_size))
           {
             std::ostringstream what;
             what << "the point (" << probes[i].point << ") lies outside the deformable bodies: ";
             if (best_distance[i] < std::numeric_limits<double>::max())
               what << "the nearest material point is " << best_distance[i] << " m away (more than a grid "
-                   << "cell diagonal, " << std::sqrt(double(dim)) * lattice.h << " m)";
+                   << "cell diagonal, " << std::sqrt(double(dim)) * cell_size << " m)";
             else
               what << "the scene has no deformable body";
             throw InputError("Output/Probe points", what.str());
@@ -237,6 +235,10 @@ namespace hysteron
       const auto       &loads = scene.load_descriptions();
       const unsigned int n    = handler->n_locally_owned_particles();
       const Lattice<dim> &lattice = grid->lattice();
+      // Where a point is: the handler holds the set-up's frame of a moving grid.
+      const auto location = [&](const Particles::ParticleAccessor<dim> &particle) {
+        return grid_moves ? grid->from_initial_frame(particle.get_location()) : particle.get_location();
+      };
 
       // First pass: the sort key of every point (handler order): group, cell, id.
       std::vector<types::particle_index> ids(n);
@@ -247,7 +249,7 @@ namespace hysteron
           {
             ids[k]   = particle.get_id();
             key[k]   = group_of_body[static_cast<unsigned int>(particle.get_properties()[PI::body])];
-            cells[k] = grid->cell_id(lattice.cell_of(particle.get_location()));
+            cells[k] = grid->cell_id(lattice.cell_of(location(particle)));
             ++k;
           }
       }
@@ -304,7 +306,7 @@ namespace hysteron
           const unsigned int s     = place[k];
           const auto        &group = P.groups[group_of[s]];
           const auto         q     = particle.get_properties();
-          const Point<dim>   x     = particle.get_location();
+          const Point<dim>   x     = location(particle);
           P.handler_index[s]       = k;
           P.id[s]                  = ids[k];
           P.cell[s]                = cells[k];
@@ -380,7 +382,27 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::to_handler()
+    Solver<dim>::insert_into_handler(const dealii::Point<dim>              &x,
+                                     const dealii::types::particle_index    id,
+                                     const dealii::ArrayView<const double> &properties)
+    {
+      // The triangulation has the set-up's geometry: the point goes where its lattice
+      // coordinates lie there (the same cell, the same unit-cell coordinates).
+      const auto         cell = grid->lattice().cell_of(x);
+      const unsigned int cid  = grid->cell_id(cell);
+      const dealii::Point<dim> y = grid_moves ? grid->to_initial_frame(x) : x;
+      handler->insert_particle(y,
+                               grid->lattice().unit_cell_point(x, cell),
+                               id,
+                               grid->cell_iterator(cid),
+                               properties);
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::to_handler(const bool physical_locations)
     {
       using namespace dealii;
       using PI = PropertiesIndex<dim>;
@@ -433,7 +455,8 @@ namespace hysteron
           q[PI::von_mises] = std::sqrt(std::max(0.0, 1.5 * dev2));
           std::fill(q.begin() + PI::n_fixed, q.end(), 0.0);
           std::copy(state, state + group.n_state, q.begin() + PI::n_fixed);
-          particle.set_location(P.current.x[s]);
+          particle.set_location(grid_moves && !physical_locations ? grid->to_initial_frame(P.current.x[s]) :
+                                                                   P.current.x[s]);
         }
     }
 
@@ -490,8 +513,14 @@ namespace hysteron
     template void Solver<3>::generate_particles();
     template void Solver<2>::from_handler();
     template void Solver<3>::from_handler();
-    template void Solver<2>::to_handler();
-    template void Solver<3>::to_handler();
+    template void Solver<2>::to_handler(bool);
+    template void Solver<3>::to_handler(bool);
+    template void Solver<2>::insert_into_handler(const dealii::Point<2> &,
+                                                 dealii::types::particle_index,
+                                                 const dealii::ArrayView<const double> &);
+    template void Solver<3>::insert_into_handler(const dealii::Point<3> &,
+                                                 dealii::types::particle_index,
+                                                 const dealii::ArrayView<const double> &);
     template struct PropertiesIndex<2>;
     template struct PropertiesIndex<3>;
     template struct ParticleStore<2>;

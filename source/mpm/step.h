@@ -30,22 +30,22 @@ namespace hysteron
         unsigned int                  base;
 
         DEAL_II_ALWAYS_INLINE inline void
-        reinit(const Lattice<dim>        &lattice,
-               const BackgroundGrid<dim> &grid,
-               const dealii::Point<dim>  &x,
-               const double               inv_h)
+        reinit(const Lattice<dim>            &lattice,
+               const BackgroundGrid<dim>     &grid,
+               const dealii::Point<dim>      &x,
+               const std::array<double, dim> &inv_h)
         {
           base = 0;
           for (unsigned int d = 0; d < dim; ++d)
             {
               int first;
-              Basis::evaluate((x[d] - lattice.origin[d]) * inv_h,
+              Basis::evaluate((x[d] - lattice.origin[d]) * inv_h[d],
                               lattice.n_cells[d],
                               first,
                               w[d],
                               g[d]);
               for (unsigned int k = 0; k < n1; ++k)
-                g[d][k] *= inv_h;
+                g[d][k] *= inv_h[d];
               base += (first - grid.box_lower(d)) * grid.stride(d);
             }
         }
@@ -91,14 +91,16 @@ namespace hysteron
       {
         explicit GridGeometry(const BackgroundGrid<dim> &grid)
           : lattice(grid.lattice())
-          , inv_h(1.0 / lattice.h)
           , s1(grid.stride(1))
           , s2(dim == 3 ? grid.stride(dim - 1) : 0)
-        {}
+        {
+          for (unsigned int d = 0; d < dim; ++d)
+            inv_h[d] = 1.0 / lattice.h[d];
+        }
 
-        const Lattice<dim> &lattice;
-        const double        inv_h;
-        const unsigned int  s1, s2;
+        const Lattice<dim>     &lattice;
+        std::array<double, dim> inv_h;
+        const unsigned int      s1, s2;
       };
     } // namespace internal
 

@@ -377,7 +377,7 @@ TEST(MpmBasisLattice, CellsNodesAndContainment)
 {
   Lattice<3> lattice;
   lattice.origin  = Point<3>(0.5, -1., 2.);
-  lattice.h       = 0.25;
+  lattice.h       = hysteron::MPM::uniform_h<3>(0.25);
   lattice.n_cells = {{4, 3, 5}};
 
   EXPECT_EQ(lattice.n_nodes_1d(0), 5u);
@@ -429,14 +429,17 @@ namespace
 
     MpmBasisTensorProduct()
     {
+      // Cells of a different size in each direction: the lattice of a grid that
+      // moved and stretched (MPM/Grid/Motion); the basis is the same in xi_d.
       const double origin[3] = {0.3, -0.7, 0.1};
+      const double h[3]      = {0.25, 0.4, 0.15};
       const unsigned int n[3] = {4, 3, 5};
       for (unsigned int d = 0; d < dim; ++d)
         {
           lattice.origin[d]  = origin[d];
           lattice.n_cells[d] = n[d];
+          lattice.h[d]       = h[d];
         }
-      lattice.h = 0.25;
     }
 
     // Nodes and cell faces and midpoints in every direction (all their
@@ -455,7 +458,7 @@ namespace
           for (unsigned int d = 0; d < dim; ++d)
             {
               const unsigned int m = 2 * lattice.n_cells[d] + 1;
-              p[d]                 = lattice.origin[d] + 0.5 * lattice.h * (r % m);
+              p[d]                 = lattice.origin[d] + 0.5 * lattice.h[d] * (r % m);
               r /= m;
             }
           points.push_back(p);
@@ -466,7 +469,7 @@ namespace
         {
           Point<dim> p;
           for (unsigned int d = 0; d < dim; ++d)
-            p[d] = lattice.origin[d] + unit(rng) * lattice.n_cells[d] * lattice.h;
+            p[d] = lattice.origin[d] + unit(rng) * lattice.n_cells[d] * lattice.h[d];
           points.push_back(p);
         }
       return points;
@@ -562,7 +565,7 @@ TYPED_TEST(MpmBasisTensorProduct, IsProductOfOneDimensionalKernels)
       for (unsigned int d = 0; d < dim; ++d)
         {
           int first;
-          Basis::evaluate((x[d] - lattice.origin[d]) / lattice.h, lattice.n_cells[d], first, v[d], dv[d]);
+          Basis::evaluate((x[d] - lattice.origin[d]) / lattice.h[d], lattice.n_cells[d], first, v[d], dv[d]);
           EXPECT_EQ(first, data.first[d]);
         }
       for (unsigned int k = 0; k < Data::n; ++k)
@@ -570,7 +573,7 @@ TYPED_TEST(MpmBasisTensorProduct, IsProductOfOneDimensionalKernels)
           double         value = 1;
           Tensor<1, dim> gradient;
           for (unsigned int d = 0; d < dim; ++d)
-            gradient[d] = 1. / lattice.h;
+            gradient[d] = 1. / lattice.h[d];
           unsigned int r = k;
           for (unsigned int d = 0; d < dim; ++d, r /= m)
             {
@@ -592,7 +595,7 @@ TYPED_TEST(MpmBasisTensorProduct, GradientsMatchFiniteDifferences)
   constexpr int dim        = TestFixture::dim;
   const bool    is_linear  = std::is_same_v<typename TestFixture::Basis, Linear1D>;
   const auto &  lattice    = this->lattice;
-  const double  delta      = 1e-6 * lattice.h;
+  const double  delta      = 1e-6 * lattice.min_h();
 
   std::vector<double>         v, vp, vm;
   std::vector<Tensor<1, dim>> g, gp, gm;
@@ -602,7 +605,7 @@ TYPED_TEST(MpmBasisTensorProduct, GradientsMatchFiniteDifferences)
       bool skip = false;
       for (unsigned int d = 0; d < dim; ++d)
         {
-          const double xi = (x[d] - lattice.origin[d]) / lattice.h;
+          const double xi = (x[d] - lattice.origin[d]) / lattice.h[d];
           const double t  = xi - std::floor(xi);
           // the linear basis has kinks at every face, the cubic one only at
           // the ends of the box where the FD stencil would leave it
@@ -621,7 +624,7 @@ TYPED_TEST(MpmBasisTensorProduct, GradientsMatchFiniteDifferences)
           this->dense(xp, vp, gp);
           this->dense(xm, vm, gm);
           for (unsigned int i = 0; i < v.size(); ++i)
-            EXPECT_NEAR(g[i][d] * lattice.h, (vp[i] - vm[i]) / (2. * delta) * lattice.h, 1e-7)
+            EXPECT_NEAR(g[i][d] * lattice.h[d], (vp[i] - vm[i]) / (2. * delta) * lattice.h[d], 1e-7)
               << "x = " << x << ", node " << i << ", direction " << d;
         }
     }
@@ -656,20 +659,20 @@ TYPED_TEST(MpmBasisCubicTensorProduct, IsC1AcrossCellFaces)
   for (auto x : this->sample_points())
     for (unsigned int d = 0; d < dim; ++d)
       {
-        const double xi = (x[d] - lattice.origin[d]) / lattice.h;
+        const double xi = (x[d] - lattice.origin[d]) / lattice.h[d];
         const double c  = std::round(xi);
         if (std::abs(xi - c) > 1e-12 || c < 1 || c > lattice.n_cells[d] - 1)
           continue;
         Point<dim> xl = x, xr = x;
-        xl[d] = lattice.origin[d] + (c - 1e-13) * lattice.h;
-        xr[d] = lattice.origin[d] + (c + 1e-13) * lattice.h;
+        xl[d] = lattice.origin[d] + (c - 1e-13) * lattice.h[d];
+        xr[d] = lattice.origin[d] + (c + 1e-13) * lattice.h[d];
         this->dense(xl, vl, gl);
         this->dense(xr, vr, gr);
         for (unsigned int i = 0; i < vl.size(); ++i)
           {
             EXPECT_NEAR(vl[i], vr[i], 1e-12) << "x = " << x << ", node " << i;
             for (unsigned int e = 0; e < dim; ++e)
-              EXPECT_NEAR(gl[i][e] * lattice.h, gr[i][e] * lattice.h, 1e-12) << "x = " << x << ", node " << i;
+              EXPECT_NEAR(gl[i][e] * lattice.h[e], gr[i][e] * lattice.h[e], 1e-12) << "x = " << x << ", node " << i;
           }
       }
 }
@@ -686,7 +689,7 @@ TYPED_TEST(MpmBasisTensorProduct, UpperCornerIsInterpolatory)
   std::array<unsigned int, dim> corner;
   for (unsigned int d = 0; d < dim; ++d)
     {
-      x[d]      = lattice.origin[d] + lattice.n_cells[d] * lattice.h;
+      x[d]      = lattice.origin[d] + lattice.n_cells[d] * lattice.h[d];
       corner[d] = lattice.n_cells[d];
     }
   ASSERT_TRUE(lattice.contains(x));
