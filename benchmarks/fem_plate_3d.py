@@ -4,7 +4,7 @@ three-dimensional, quasi-static Bouc-Wen plasticity to collapse, on 1 and 2 MPI 
 
     fem_plate_3d.py --hysteron build/hysteron [--cells 40,40,13] [--degree 2] [--b-bar]
                     [--ranks 1,2] [--increments 20] [--linear-tolerance 1e-10]
-                    [--workdir DIR] [--mesh-only]
+                    [--workdir DIR] [--out FILE.md] [--mesh-only]
 
 Geometry (a quarter of the plate and half of its thickness, symmetric about x = 0, y = 0 and
 z = 0): x in [0, 0.25] m, y in [0, 0.45] m, z in [0, 0.05] m, a hole of radius 0.125 m about the
@@ -25,7 +25,8 @@ aggregated on the rigid-body modes (the `automatic` solver above 100,000 DoFs).
 Reported per rank count: the wall time of the whole run and of its timer sections, Newton and
 Krylov iterations, the peak resident memory of each rank (GNU time), the force at 4 mm (the
 collapse plateau), the force over the net-section limit sigma_y (W - R) T of the ligament in
-uniaxial stress, and the force's change over the last quarter. Writes WORKDIR/results.json.
+uniaxial stress, and the force's change over the last quarter. Writes WORKDIR/results.json and,
+with --out, a markdown table of the runs (doc/benchmarks/fem_plate_3d_*.md).
 """
 import argparse
 import json
@@ -155,6 +156,7 @@ def main():
     parser.add_argument("--increments", type=int, default=20)
     parser.add_argument("--workdir", default="/tmp/fem_plate_3d")
     parser.add_argument("--mesh-only", action="store_true")
+    parser.add_argument("--out", help="write the markdown table of the runs here")
     args = parser.parse_args()
     n_theta, n_r, n_z = map(int, args.cells.split(","))
     os.makedirs(args.workdir, exist_ok=True)
@@ -174,7 +176,9 @@ def main():
         with open(os.path.join(directory, "scene.prm"), "w") as f:
             f.write(scene(args.degree, args.increments, args.b_bar, args.linear_tolerance))
         # GNU time around each rank: its peak resident set.
-        command = ["mpirun", "-np", str(ranks), "/usr/bin/time", "-f", "peak_rss_kb %M",
+        # (appended to one file: the ranks' reports would interleave on stderr)
+        rss_file = os.path.join(directory, "peak_rss.txt")
+        command = ["mpirun", "-np", str(ranks), "/usr/bin/time", "-a", "-o", rss_file, "-f", "peak_rss_kb %M",
                    os.path.abspath(args.hysteron), "scene.prm"]
         start = time.monotonic()
         p = subprocess.run(command, cwd=directory, env=env, capture_output=True, text=True)
@@ -188,7 +192,7 @@ def main():
                     re.finditer(r"\| ([A-Za-z -]+?)\s+\|\s+(\d+) \|\s+([0-9.e+-]+)s \|", log)}
         summary = re.search(r"\((\d+) steps, (\d+) Newton iterations.*?(\d+) DoFs", log)
         linear = re.search(r"(\d+) linear iterations", log)
-        rss = [int(v) for v in re.findall(r"peak_rss_kb (\d+)", log)]
+        rss = [int(v) for v in re.findall(r"peak_rss_kb (\d+)", open(rss_file).read())]
         with open(os.path.join(directory, "output", "reactions.csv")) as f:
             rows = [line.strip().split(",") for line in f if line.strip()]
         column = rows[0].index("top_y")
@@ -207,6 +211,27 @@ def main():
         json.dump(results, f, indent=1)
     if len(results) > 1:
         print(f"speed-up on {results[-1]['ranks']} ranks: {results[0]['wall'] / results[-1]['wall']:.2f}")
+    if args.out:
+        element = f"Q{args.degree}" + (" + B-bar" if args.b_bar else "")
+        model = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo")
+                      if line.startswith("model name")), "?")
+        lines = [f"{element}, {n_theta} x {n_r} x {n_z} cells, {3 * n_nodes:,} DoFs, {args.increments} increments "
+                 f"to u_y = 4 mm, GMRES + ML on the rigid-body modes, Krylov tolerance {args.linear_tolerance:g}; "
+                 f"machine: {os.cpu_count()} cores, {model}; one run per rank count; command: "
+                 f"`benchmarks/fem_plate_3d.py --hysteron build/hysteron --cells {args.cells} --degree {args.degree}"
+                 f"{' --b-bar' if args.b_bar else ''} --ranks {args.ranks} --increments {args.increments} "
+                 f"--linear-tolerance {args.linear_tolerance:g}`", "",
+                 "| ranks | wall [s] | assembly [s] | linear solve [s] | Newton iterations | Krylov iterations | "
+                 "peak memory per rank [MB] | F at 4 mm / net-section limit | change over the last quarter | speed-up |",
+                 "|---|---|---|---|---|---|---|---|---|---|"]
+        for r in results:
+            speed_up = f"{results[0]['wall'] / r['wall']:.2f}" if results[0]["ranks"] == 1 else "—"
+            lines.append(f"| {r['ranks']} | {r['wall']:.1f} | {r['sections'].get('FEM assembly', float('nan')):.1f} | "
+                         f"{r['sections'].get('FEM linear solve', float('nan')):.1f} | {r['newton']} | "
+                         f"{r['linear_iterations']} | {', '.join(f'{m:.0f}' for m in r['peak_rss_mb'])} | "
+                         f"{r['force_over_net_section']:.4f} | {100 * r['last_quarter']:+.2f} % | {speed_up} |")
+        with open(args.out, "w") as f:
+            f.write("\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

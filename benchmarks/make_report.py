@@ -25,11 +25,14 @@ Studies (name: script; minutes on the 2-core Xeon VM with --repeats 3):
   rbsn_cantilever_plastic      §5.1 RBSN, uncoupled against coupled springs                   3
   rbsn_newmark_vs_variable_order  §3.6.1 element, Newmark against IDA                        3
   mpm_throughput               run_mpm_benchmark.py (M particle-steps/s, 2-rank efficiency)   3
+  fem_plate_3d                 3D plate, Q1 + B-bar, 531,441 DoFs to collapse on 2 ranks     25
+  fem_plate_3d_speedup         the same plate at 132,651 DoFs on 1 and 2 ranks               12
   pay_for_use                  callgrind instruction counts (deterministic)                  10
 
 Each study runs pinned to one core (taskset). With --lanes 2 two studies run at a time, one per
 core (shorter, but they share the memory bus and the L3 cache; the report says so); the
-throughput study, which needs both cores for its 2-rank run, then runs alone at the end.
+throughput and plate studies, which need both cores for their 2-rank runs, then run alone at
+the end.
 --quick runs every study's quick subset into a temporary directory (throughput and callgrind
 skipped) to check the pipeline in a few minutes; its report is not for committing.
 
@@ -111,6 +114,18 @@ def studies(args, out, work):
                  "--workdir", f"{work}/ida", *q), 3),
         Study("pay_for_use", py("pay_for_use.py", "--out", out), 10, in_quick=False),
         Study("mpm_throughput", py("run_mpm_benchmark.py", "--repeats", r, "--out", out), 3,
+              exclusive=True, in_quick=False),
+        # The 3D plate of 531,441 DoFs on 2 ranks, and the 2-rank speed-up on a quarter of it:
+        # both cores, one run each (about 25 and 12 minutes).
+        Study("fem_plate_3d",
+              [PY, os.path.join(bench, "fem_plate_3d.py"), "--hysteron", os.path.join(b, "hysteron"),
+               "--cells", "80,80,26", "--degree", "1", "--b-bar", "--ranks", "2", "--linear-tolerance", "1e-6",
+               "--workdir", f"{work}/plate_large", "--out", os.path.join(out, "fem_plate_3d_large.md")], 25,
+              exclusive=True, in_quick=False),
+        Study("fem_plate_3d_speedup",
+              [PY, os.path.join(bench, "fem_plate_3d.py"), "--hysteron", os.path.join(b, "hysteron"),
+               "--cells", "50,50,16", "--degree", "1", "--b-bar", "--ranks", "1,2", "--linear-tolerance", "1e-6",
+               "--workdir", f"{work}/plate_medium", "--out", os.path.join(out, "fem_plate_3d_medium.md")], 12,
               exclusive=True, in_quick=False),
     ]
 
@@ -533,11 +548,12 @@ def main():
                               for s in selected)
             measured["studies"] += f"; rerun with --only: {reran}"
             write_atomically(run_file, json.dumps(measured, indent=1))
-        info.update({k: measured[k] for k in keys})
+        # The machine of the full run (older records lack it: then this one's).
+        info.update({k: measured[k] for k in keys + ("cpu", "os", "memory") if k in measured})
         if args.report_only:
             info["command"] += " (report rebuilt by --report-only)"
     elif not args.quick:
-        write_atomically(run_file, json.dumps({k: info[k] for k in keys}, indent=1))
+        write_atomically(run_file, json.dumps({k: info[k] for k in keys + ("cpu", "os", "memory")}, indent=1))
     context = Context(scenes, out, info)
     text = fill(open(os.path.join(ROOT, "benchmarks", "benchmarks.md.in")).read(), namespace(context),
                 "make_report.py")

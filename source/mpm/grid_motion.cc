@@ -86,7 +86,8 @@ namespace hysteron
 
       // Entries of the other types would act on nothing.
       if (grid_motion != GridMotion::follow)
-        require(followed.empty(), s.where("Bodies"), "is set but the grid does not follow bodies (Type = " + type + ")");
+        for (const auto &[entry, unset] : {std::make_pair("Bodies", followed.empty()), std::make_pair("Stretch", motion_stretches)})
+          require(unset, s.where(entry), "is set but the grid does not follow bodies (Type = " + type + ")");
       if (grid_motion != GridMotion::prescribed)
         for (const auto &[entry, text] : {std::make_pair("Velocity", velocity), std::make_pair("Stretch rate", rate)})
           require(text.empty(), s.where(entry), "is set but the grid motion is not prescribed (Type = " + type + ")");

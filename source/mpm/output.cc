@@ -152,7 +152,7 @@ namespace hysteron
     void
     Solver<dim>::write_fields(const double t, Output::FieldWriter &writer)
     {
-      to_handler();
+      to_handler(true); // the points where they are, also on a moving grid
       using PI = PropertiesIndex<dim>;
       std::vector<std::string> names = PI::names(state_names);
       names.resize(n_properties, "unused");
