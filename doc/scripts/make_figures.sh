@@ -46,3 +46,6 @@ $plot --x time --y tip_y --xscale 30 --yscale=-1e-3 --xlabel "tip deflection [mm
 # loop of its named set `tip` itself (history_tip.png, with gnuplot).
 mkdir -p fem_cyclic && (cd fem_cyclic && "$exe" --quiet "$root/doc/scenes/fem_cantilever_cyclic.prm")
 cp fem_cyclic/output/history_tip.png "$fig/fem_cantilever_cyclic_history.png"
+
+# The §5.4 fine patch on a fixed and on a moving grid (doc/mpm.md, "Moving grid").
+/usr/bin/python3 "$root/doc/scripts/make_moving_grid_figure.py" "$exe"
