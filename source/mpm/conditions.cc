@@ -55,7 +55,7 @@ namespace hysteron
           // A condition acts on grid nodes: one that selects none acts on nothing.
           require(n_nodes > 0,
                   "Boundary " + description.name + (description.has_region ? "/Region" : "/Faces"),
-                  "selects no grid node (the background grid is " + grid_extent() + ")");
+                  "selects no grid node (the background grid is " + grid_extent(grid->lattice()) + ")");
           boundaries.push_back(std::move(b));
         }
       boundary_acted.assign(boundaries.size(), false);
@@ -65,10 +65,9 @@ namespace hysteron
 
     template <int dim>
     std::string
-    Solver<dim>::grid_extent() const
+    Solver<dim>::grid_extent(const Lattice<dim> &lattice) const
     {
-      const auto        &lattice = grid->lattice();
-      const auto         upper   = lattice.upper();
+      const auto         upper = lattice.upper();
       std::ostringstream s;
       for (unsigned int d = 0; d < dim; ++d)
         s << (d > 0 ? " x [" : "[") << lattice.origin[d] << ", " << upper[d] << "]";
@@ -188,8 +187,8 @@ namespace hysteron
 
     template void Solver<2>::setup_boundaries();
     template void Solver<3>::setup_boundaries();
-    template std::string Solver<2>::grid_extent() const;
-    template std::string Solver<3>::grid_extent() const;
+    template std::string Solver<2>::grid_extent(const Lattice<2> &) const;
+    template std::string Solver<3>::grid_extent(const Lattice<3> &) const;
     template void Solver<2>::warn_about_idle_boundaries() const;
     template void Solver<3>::warn_about_idle_boundaries() const;
     template void Solver<2>::apply_boundary_conditions(double, double, bool);

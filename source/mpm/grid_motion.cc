@@ -11,6 +11,7 @@
 #include "mpm/mpm.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -195,7 +196,7 @@ namespace hysteron
           // Delta_p = x_p' - x_p in each direction against xi_p = x_p - o_d:
           // Delta(xi) = a + B xi. The sums: the failed points (this rank), M, then per
           // direction S1 = sum m xi, S2 = sum m xi^2, D1 = sum m Delta, X1 = sum m xi Delta.
-          std::vector<double> sums(2 + 4 * dim, 0.0);
+          std::array<double, 2 + 4 * dim> sums{};
           sums[0] = failed_point >= 0 ? 1 : 0;
           for (const auto &group : P.groups)
             if (group.material != nullptr)
@@ -308,11 +309,7 @@ namespace hysteron
         }
 
       // Every point must lie in the moved grid.
-      std::ostringstream extent;
-      const auto         upper = moved.upper();
-      for (unsigned int d = 0; d < dim; ++d)
-        extent << (d > 0 ? " x [" : "[") << moved.origin[d] << ", " << upper[d] << "]";
-      moved_extent = extent.str();
+      last_moved_lattice = moved;
       if (failed_point < 0)
         for (unsigned int p = 0; p < P.size(); ++p)
           if (!moved.contains(P.next.x[p]))

@@ -311,7 +311,7 @@ namespace hysteron
               << "; enlarge MPM/Grid or check the loads and boundary conditions)";
           else if (failure == "a material point left the moving grid")
             m << " moved to " << format_point(x_new, dim) << ", outside the grid as it moved in the step (to "
-              << moved_extent << "; "
+              << grid_extent(last_moved_lattice) << "; "
               << (grid_motion == GridMotion::follow ?
                     "the grid follows the affine part of the followed bodies' motion, which a body "
                     "that is not followed, or one that deforms far from affinely (an impact), can "

@@ -185,8 +185,8 @@ namespace hysteron
       /// The grid's lower corner and cell sizes at the rows of grid.csv (rank 0).
       std::unique_ptr<Output::TimeTable>           grid_table;
       double                                       grid_table_time = -1;
-      /// "[x0, x1] x [y0, y1]" of the lattice moved_lattice() computed last (messages).
-      std::string                                  moved_extent;
+      /// The lattice moved_lattice() computed last (for the failure message).
+      Lattice<dim>                                 last_moved_lattice;
       static void
       declare_grid_motion_parameters(dealii::ParameterHandler &prm);
       void
@@ -214,9 +214,9 @@ namespace hysteron
       generate_particles();
       void
       setup_boundaries();
-      /// "[x0, x1] x [y0, y1]": the background grid, for messages.
+      /// "[x0, x1] x [y0, y1]": the extent of @p lattice (the background grid), for messages.
       std::string
-      grid_extent() const;
+      grid_extent(const Lattice<dim> &lattice) const;
       /// A warning for every boundary condition that constrained no node with mass.
       void
       warn_about_idle_boundaries() const;
