@@ -217,7 +217,7 @@ def main():
                       if line.startswith("model name")), "?")
         lines = [f"{element}, {n_theta} x {n_r} x {n_z} cells, {3 * n_nodes:,} DoFs, {args.increments} increments "
                  f"to u_y = 4 mm, GMRES + ML on the rigid-body modes, Krylov tolerance {args.linear_tolerance:g}; "
-                 f"machine: {os.cpu_count()} cores, {model}; one run per rank count; command: "
+                 f"machine: {os.cpu_count()} cores, {model}; the build of --hysteron (Release for timings); one run per rank count; command: "
                  f"`benchmarks/fem_plate_3d.py --hysteron build/hysteron --cells {args.cells} --degree {args.degree}"
                  f"{' --b-bar' if args.b_bar else ''} --ranks {args.ranks} --increments {args.increments} "
                  f"--linear-tolerance {args.linear_tolerance:g}`", "",
