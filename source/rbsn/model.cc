@@ -66,13 +66,13 @@ namespace hysteron
                           "springs yield at sigma_y t l and sigma_y t l / sqrt(3).");
         prm.declare_entry("Spring law",
                           "uncoupled",
-                          Patterns::Selection(SpringLawRegistry::pattern_string()),
+                          Patterns::Selection(SpringLawRegistry<2>::pattern_string()),
                           "The law of the facet springs, a registered plugin (doc/rbsn.md; plugins "
                           "from Additional shared libraries too). The built-in laws take the facets "
                           "between Bouc-Wen cells (linear-elastic ones have linear springs); "
                           "Analysis = static has linear springs throughout:" +
-                            SpringLawRegistry::documentation());
-        SpringLawRegistry::declare_parameters(prm);
+                            SpringLawRegistry<2>::documentation());
+        SpringLawRegistry<2>::declare_parameters(prm);
         prm.declare_entry("Analysis",
                           "quasi-static",
                           Patterns::Selection("static|quasi-static|implicit dynamics|variable order"),
@@ -194,13 +194,13 @@ namespace hysteron
         if (!distance.empty() && end == distance.c_str() + distance.size())
           {
             d_m     = s.get_positive("Minimum distance");
-            spacing = Spacing(d_m);
+            spacing = Spacing<2>(d_m);
           }
         else
           {
             const std::shared_ptr<const dealii::FunctionParser<2>> d =
               parse_function<2>(distance, "x,y", false, s.where("Minimum distance"));
-            spacing = Spacing([d](const dealii::Point<2> &p) { return d->value(p); },
+            spacing = Spacing<2>([d](const dealii::Point<2> &p) { return d->value(p); },
                               distance,
                               s.where("Minimum distance"));
           }
@@ -210,7 +210,7 @@ namespace hysteron
         shear_ratio  = s.get_non_negative("Shear stiffness ratio");
         moment_yield = s.get_positive("Moment yield factor");
         spring_law_name = s.get("Spring law");
-        spring_law      = SpringLawRegistry::create(spring_law_name, s.where("Spring law"));
+        spring_law      = SpringLawRegistry<2>::create(spring_law_name, s.where("Spring law"));
         spring_law->parse_parameters(s);
         const std::string type = s.get("Analysis");
         analysis = type == "static"            ? Analysis::linear_static :
@@ -413,7 +413,7 @@ namespace hysteron
       springs.assign(network.facets.size(), Springs());
       for (unsigned int e = 0; e < network.facets.size(); ++e)
         {
-          const Facet &f  = network.facets[e];
+          const Facet<2> &f  = network.facets[e];
           Springs     &sp = springs[e];
           const auto  &ba = bodies[cell_body[f.a]], &bb = bodies[cell_body[f.b]];
           const auto  &ma = scene.material(ba.material, "Body " + ba.name + "/Material");
@@ -429,7 +429,7 @@ namespace hysteron
                                                f.h_b / mb.elasticity().shear_modulus());
           sp.k[2]      = sp.k[0] * l * l / 12;
           sp.thickness = t;
-          FacetSprings facet;
+          FacetSprings<2> facet;
           facet.k                   = sp.k;
           facet.thickness           = t;
           facet.length              = l;

@@ -272,7 +272,7 @@ namespace hysteron
           if (distributed() && !owned_facet[e])
             continue;
           const Springs &sp = springs[e];
-          const Facet   &f  = network.facets[e];
+          const Facet<2>   &f  = network.facets[e];
           add_point(f.p3, f.a);
           add_point(f.p4, f.a);
           offsets.push_back(connectivity.size());
@@ -372,7 +372,7 @@ namespace hysteron
                              "broken"});
       for (unsigned int e = 0; e < springs.size(); ++e)
         {
-          const Facet   &f  = network.facets[e];
+          const Facet<2>   &f  = network.facets[e];
           const Springs &sp = springs[e];
           std::vector<double> row{double(f.a), double(f.b), f.midpoint[0], f.midpoint[1], f.normal[0],
                                   f.normal[1], f.length, f.distance, sp.thickness, sp.k[0], sp.k[1],

@@ -90,7 +90,7 @@ namespace hysteron
           block(c, c);
       for (const unsigned int e : owned_facets)
         {
-          const Facet &f = network.facets[e];
+          const Facet<2> &f = network.facets[e];
           for (const unsigned int p : {f.a, f.b})
             {
               relevant.add_range(3 * p, 3 * p + 3);

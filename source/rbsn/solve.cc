@@ -81,7 +81,7 @@ namespace hysteron
       // The springs' matrix for the tangent D: B^T D B (the diagonal of D only, for linear
       // springs and laws of independent springs; else the full, not necessarily symmetric
       // D), in dynamics times 1 + alpha. Linear in D.
-      const auto spring_matrix = [&](const Springs &sp, const SpringLaw::Matrix &D, dealii::FullMatrix<double> &M) {
+      const auto spring_matrix = [&](const Springs &sp, const SpringLaw<2>::Matrix &D, dealii::FullMatrix<double> &M) {
         const bool diagonal = diagonal_law || !sp.hysteretic;
         for (unsigned int p = 0; p < 6; ++p)
           for (unsigned int q = 0; q < 6; ++q)
@@ -99,7 +99,7 @@ namespace hysteron
       };
       // The facet's matrix: the springs' and, in dynamics, the damping (1 + alpha) gamma /
       // (beta dt) a1 K0.
-      const auto facet_matrix = [&](const Springs &sp, const SpringLaw::Matrix &D, dealii::FullMatrix<double> &M) {
+      const auto facet_matrix = [&](const Springs &sp, const SpringLaw<2>::Matrix &D, dealii::FullMatrix<double> &M) {
         spring_matrix(sp, D, M);
         if (dynamic && dynamics.rayleigh_stiffness > 0)
           {
@@ -115,7 +115,7 @@ namespace hysteron
           Springs &sp = springs[e];
           if (distributed() && !owned_facet[e])
             continue;
-          const Facet &f = network.facets[e];
+          const Facet<2> &f = network.facets[e];
           for (unsigned int k = 0; k < 3; ++k)
             {
               dofs[k]     = 3 * f.a + k;
@@ -136,7 +136,7 @@ namespace hysteron
             }
           for (unsigned int k = 0; k < 6; ++k)
             ue[k] = u_trial(dofs[k]);
-          SpringLaw::Vector increment;
+          SpringLaw<2>::Vector increment;
           for (unsigned int i = 0; i < 3; ++i)
             {
               sp.trial_delta[i] = sp.deformation(i, ue);
@@ -574,7 +574,7 @@ namespace hysteron
       if (dynamics.rayleigh_stiffness > 0)
         for (unsigned int e = 0; e < springs.size(); ++e)
           {
-            const Facet   &f  = network.facets[e];
+            const Facet<2>   &f  = network.facets[e];
             const Springs &sp = springs[e];
             const double   U[6] = {v(3 * f.a), v(3 * f.a + 1), v(3 * f.a + 2), v(3 * f.b), v(3 * f.b + 1), v(3 * f.b + 2)};
             for (unsigned int i = 0; i < 3; ++i)

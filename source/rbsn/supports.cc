@@ -131,7 +131,7 @@ namespace hysteron
     {
       // The facet's cells in different fragments: the smaller one separated.
       Separation   s;
-      const Facet &f = network.facets[e];
+      const Facet<2> &f = network.facets[e];
       if (fragment[f.a] != fragment[f.b])
         {
           std::array<unsigned int, 2> size{{0, 0}};

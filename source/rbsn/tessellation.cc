@@ -176,16 +176,18 @@ namespace hysteron
 
 
 
-    Spacing::Spacing(const double d_m)
+    template <int dim>
+    Spacing<dim>::Spacing(const double d_m)
       : min(d_m)
       , max(d_m)
     {}
 
 
 
-    Spacing::Spacing(std::function<double(const dealii::Point<2> &)> function,
-                     const std::string                              &expression,
-                     const std::string                              &where)
+    template <int dim>
+    Spacing<dim>::Spacing(std::function<double(const dealii::Point<dim> &)> function,
+                          const std::string                                &expression,
+                          const std::string                                &where)
       : function(std::move(function))
       , expression(expression)
       , where(where)
@@ -193,8 +195,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     double
-    Spacing::operator()(const dealii::Point<2> &p) const
+    Spacing<dim>::operator()(const dealii::Point<dim> &p) const
     {
       if (!function)
         return min;
@@ -204,7 +207,10 @@ namespace hysteron
           std::ostringstream s;
           s.precision(6);
           s << "the expression '" << expression << "' evaluates to " << d << " at x = " << p[0]
-            << ", y = " << p[1] << ": the minimum distance must be > 0 in the bodies";
+            << ", y = " << p[1];
+          if (dim == 3)
+            s << ", z = " << p[dim - 1];
+          s << ": the minimum distance must be > 0 in the bodies";
           throw InputError(where, s.str());
         }
       return d;
@@ -212,59 +218,105 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Spacing::sample(const std::vector<const Geometry::Region<2> *> &bodies)
+    Spacing<dim>::sample(const std::vector<const Geometry::Region<dim> *> &bodies)
     {
-      Point lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max()), hi = -lo;
+      dealii::Point<dim> lo, hi;
+      for (unsigned int k = 0; k < dim; ++k)
+        {
+          lo[k] = std::numeric_limits<double>::max();
+          hi[k] = -lo[k];
+        }
       for (const auto *b : bodies)
         {
           const auto box = b->bounding_box().get_boundary_points();
-          for (unsigned int k = 0; k < 2; ++k)
+          for (unsigned int k = 0; k < dim; ++k)
             {
               lo[k] = std::min(lo[k], box.first[k]);
               hi[k] = std::max(hi[k], box.second[k]);
             }
         }
-      const double wx = hi[0] - lo[0], wy = hi[1] - lo[1];
-      if (!(wx > 0 && wy > 0 && std::isfinite(wx * wy)))
+      double measure = 1;
+      for (unsigned int k = 0; k < dim; ++k)
+        measure *= hi[k] - lo[k];
+      if (!(measure > 0 && std::isfinite(measure)))
         return; // unbounded or degenerate: poisson_disk_points() says so
-      // Square cells, about 2^16 of them.
-      const double       h  = std::sqrt(wx * wy / 65536.0);
-      const unsigned int nx = std::max(1, static_cast<int>(std::ceil(wx / h))),
-                         ny = std::max(1, static_cast<int>(std::ceil(wy / h)));
-      const double       hx = wx / nx, hy = wy / ny;
-      std::vector<double> value(static_cast<std::size_t>(nx) * ny, 0.0); // 0: outside
+      // Square (cubic) cells, about 2^16 (2^18) of them.
+      const double h = dim == 2 ? std::sqrt(measure / 65536.0) : std::cbrt(measure / 262144.0);
+      std::array<unsigned int, dim> n;
+      dealii::Tensor<1, dim>        step;
+      std::size_t                   total = 1;
+      double                        cell  = 1;
+      for (unsigned int k = 0; k < dim; ++k)
+        {
+          n[k]    = std::max(1, static_cast<int>(std::ceil((hi[k] - lo[k]) / h)));
+          step[k] = (hi[k] - lo[k]) / n[k];
+          total *= n[k];
+          cell *= step[k];
+        }
+      std::vector<double> value(total, 0.0); // 0: outside
       double              integral = 0, smallest = std::numeric_limits<double>::max(), largest = 0;
-      for (unsigned int j = 0; j < ny; ++j)
-        for (unsigned int i = 0; i < nx; ++i)
-          {
-            const Point x(lo[0] + (i + 0.5) * hx, lo[1] + (j + 0.5) * hy);
-            if (std::none_of(bodies.begin(), bodies.end(), [&](const auto *b) { return b->contains(x); }))
-              continue;
-            const double d                              = (*this)(x);
-            value[static_cast<std::size_t>(j) * nx + i] = d;
-            integral += hx * hy / (d * d);
-            smallest = std::min(smallest, d);
-            largest  = std::max(largest, d);
-          }
-      predicted_points = 0.68 * integral;
+      const auto index = [&](const std::array<unsigned int, dim> &i) {
+        std::size_t k = 0;
+        for (int d = dim - 1; d >= 0; --d)
+          k = k * n[d] + i[d];
+        return k;
+      };
+      // The samples in the order x fastest (as the 2D loops over j, then i).
+      for (std::size_t k = 0; k < total; ++k)
+        {
+          std::array<unsigned int, dim> i;
+          std::size_t                   r = k;
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              i[d] = r % n[d];
+              r /= n[d];
+            }
+          dealii::Point<dim> x;
+          for (unsigned int d = 0; d < dim; ++d)
+            x[d] = lo[d] + (i[d] + 0.5) * step[d];
+          if (std::none_of(bodies.begin(), bodies.end(), [&](const auto *b) { return b->contains(x); }))
+            continue;
+          const double d = (*this)(x);
+          value[k]       = d;
+          integral += cell / (dim == 2 ? d * d : d * d * d);
+          smallest = std::min(smallest, d);
+          largest  = std::max(largest, d);
+        }
+      predicted_points = density * integral;
       if (function && largest > 0)
         {
           min = smallest;
           max = largest;
           // |grad d| from the differences of neighbouring samples in the bodies.
           gradient = 0;
-          for (unsigned int j = 0; j < ny; ++j)
-            for (unsigned int i = 0; i < nx; ++i)
-              if (const double d = value[static_cast<std::size_t>(j) * nx + i]; d > 0)
-                {
-                  if (i + 1 < nx && value[static_cast<std::size_t>(j) * nx + i + 1] > 0)
-                    gradient = std::max(gradient, std::abs(value[static_cast<std::size_t>(j) * nx + i + 1] - d) / hx);
-                  if (j + 1 < ny && value[static_cast<std::size_t>(j + 1) * nx + i] > 0)
-                    gradient = std::max(gradient, std::abs(value[static_cast<std::size_t>(j + 1) * nx + i] - d) / hy);
-                }
+          for (std::size_t k = 0; k < total; ++k)
+            if (const double d = value[k]; d > 0)
+              {
+                std::array<unsigned int, dim> i;
+                std::size_t                   r = k;
+                for (unsigned int q = 0; q < dim; ++q)
+                  {
+                    i[q] = r % n[q];
+                    r /= n[q];
+                  }
+                for (unsigned int q = 0; q < dim; ++q)
+                  if (i[q] + 1 < n[q])
+                    {
+                      auto next = i;
+                      ++next[q];
+                      if (const double e = value[index(next)]; e > 0)
+                        gradient = std::max(gradient, std::abs(e - d) / step[q]);
+                    }
+              }
         }
     }
+
+
+
+    template class Spacing<2>;
+    template class Spacing<3>;
 
 
 
@@ -276,14 +328,14 @@ namespace hysteron
                         const std::string                   &where)
     {
       require(d_m > 0 && std::isfinite(d_m), where, "the minimum distance must be > 0");
-      return poisson_disk_points(domain, Spacing(d_m), fixed, seed, where);
+      return poisson_disk_points(domain, Spacing<2>(d_m), fixed, seed, where);
     }
 
 
 
     std::vector<dealii::Point<2>>
     poisson_disk_points(const Geometry::Region<2>           &domain,
-                        const Spacing                       &d,
+                        const Spacing<2>                    &d,
                         const std::vector<dealii::Point<2>> &fixed,
                         const std::uint64_t                  seed,
                         const std::string                   &where)
@@ -495,7 +547,7 @@ namespace hysteron
 
 
     std::vector<dealii::Point<2>>
-    boundary_points(const Geometry::Region<2> &domain, const Spacing &spacing, const double boundary_h)
+    boundary_points(const Geometry::Region<2> &domain, const Spacing<2> &spacing, const double boundary_h)
     {
       const auto   box   = domain.bounding_box().get_boundary_points();
       const double scale = box.first.distance(box.second);
@@ -583,11 +635,12 @@ namespace hysteron
 
 
 
-    Tessellation
-    voronoi(const std::vector<dealii::Point<2>>           &nuclei,
+    Tessellation<2>
+    voronoi(const std::vector<dealii::Point<2>>            &nuclei,
             const std::vector<const Geometry::Region<2> *> &bodies,
             const double                                    boundary_h,
-            const std::string                              &where)
+            const std::string                              &where,
+            const std::vector<bool>                        &wanted)
     {
       using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
       using Vb     = CGAL::Triangulation_vertex_base_with_info_2<unsigned int, Kernel>;
@@ -680,12 +733,14 @@ namespace hysteron
           std::sort(neighbours[v->info()].begin(), neighbours[v->info()].end());
         }
 
-      Tessellation result;
+      Tessellation<2> result;
       result.cells.resize(nuclei.size());
       std::map<std::pair<unsigned int, unsigned int>, std::vector<Segment>> facet_pieces;
       const double eps = 1e-9 * scale;
       for (unsigned int i = 0; i < nuclei.size(); ++i)
         {
+          if (!wanted.empty() && !wanted[i])
+            continue;
           // The convex Voronoi cell: the box around the domain clipped by the
           // bisector of every neighbour (each edge tagged with its neighbour).
           const double       margin = 0.5 * scale;
@@ -832,8 +887,11 @@ namespace hysteron
               result.cells[i].boundary.push_back(Segment{{a, b}});
             }
 
-          Cell &cell = result.cells[i];
+          Cell<2> &cell = result.cells[i];
           cell.nucleus = nuclei[i];
+          for (const auto &piece : pieces)
+            for (const auto &p : piece)
+              cell.reach = std::max(cell.reach, p.distance(nuclei[i]));
           cell.area    = moments.area;
           require(cell.area > 0, where, "the cell of the point " + text(nuclei[i]) + " has no area in the bodies");
           cell.centroid     = Point(moments.sx / moments.area, moments.sy / moments.area);
@@ -844,7 +902,7 @@ namespace hysteron
       // Facets: the Voronoi edges in the domain (pieces across a hole joined).
       for (const auto &[cells, pieces] : facet_pieces)
         {
-          Facet  f;
+          Facet<2> f;
           f.a = cells.first;
           f.b = cells.second;
           dealii::Tensor<1, 2> weighted;

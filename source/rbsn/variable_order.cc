@@ -162,8 +162,8 @@ namespace hysteron
       /// Per spring (index 3 e + i): the offset of its Bouc-Wen state within s, -1 if linear.
       std::vector<int>              state_offset;
       /// Per spring (index 3 e + i) of a hysteretic facet: its uniaxial law and the
-      /// offset of its state in the facet's state (SpringLaw::uniaxial_spring()).
-      std::vector<SpringLaw::UniaxialSpring> uniaxial;
+      /// offset of its state in the facet's state (SpringLaw<2>::uniaxial_spring()).
+      std::vector<SpringLaw<2>::UniaxialSpring> uniaxial;
       std::vector<double>           w; ///< prescribed velocities at the last t
       Vector                        reaction, f_ext;
       dealii::SparsityPattern       pattern;
@@ -192,7 +192,7 @@ namespace hysteron
       std::array<unsigned int, 6>
       facet_dofs(const unsigned int e) const
       {
-        const Facet &f = m.network.facets[e];
+        const Facet<2> &f = m.network.facets[e];
         return {{3 * f.a, 3 * f.a + 1, 3 * f.a + 2, 3 * f.b, 3 * f.b + 1, 3 * f.b + 2}};
       }
     };
@@ -204,7 +204,7 @@ namespace hysteron
       , n(model.u.size())
     {
       state_offset.assign(3 * m.springs.size(), -1);
-      uniaxial.assign(3 * m.springs.size(), SpringLaw::UniaxialSpring());
+      uniaxial.assign(3 * m.springs.size(), SpringLaw<2>::UniaxialSpring());
       for (unsigned int e = 0; e < m.springs.size(); ++e)
         if (m.springs[e].hysteretic)
           for (unsigned int i = 0; i < 3; ++i)

@@ -18,31 +18,39 @@ namespace custom
   using hysteron::RBSN::FacetSprings;
   using hysteron::RBSN::SpringLaw;
 
-  class NoTension : public SpringLaw
+  /// For 2D and 3D networks: the first spring is the normal one in both (the others are
+  /// the tangential and rotational springs in 2D; two shear, two bending and the torsion
+  /// spring in 3D).
+  template <int dim>
+  class NoTension : public SpringLaw<dim>
   {
   public:
-    /// The three total deformations (delta_n, delta_t, phi).
+    using typename SpringLaw<dim>::Vector;
+    using typename SpringLaw<dim>::Matrix;
+    static constexpr unsigned int n = SpringLaw<dim>::n;
+
+    /// The total deformations (2D: delta_n, delta_t, phi).
     unsigned int
     n_state_variables() const override
     {
-      return 3;
+      return n;
     }
 
     bool
     setup_facet(const unsigned int e,
-                const FacetSprings &springs,
-                const hysteron::Material::Interface<2> &,
-                const hysteron::Material::Interface<2> &,
+                const FacetSprings<dim> &springs,
+                const hysteron::Material::Interface<dim> &,
+                const hysteron::Material::Interface<dim> &,
                 double *state) override
     {
       k(e) = springs.k;
-      std::fill(state, state + 3, 0.0);
+      std::fill(state, state + n, 0.0);
       return true;
     }
 
     /// The tangent is exact (the material's own integrator plays no part).
     bool
-    has_consistent_tangent(const hysteron::Material::Interface<2> &) const override
+    has_consistent_tangent(const hysteron::Material::Interface<dim> &) const override
     {
       return true;
     }
@@ -60,14 +68,13 @@ namespace custom
            double            *delta,
            Matrix            *tangent) const override
     {
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < n; ++i)
         delta[i] += increment[i];
       const bool open = delta[0] > 0;
-      force[0]        = open ? 0.0 : k[e][0] * delta[0];
-      force[1]        = k[e][1] * delta[1];
-      force[2]        = k[e][2] * delta[2];
+      for (unsigned int i = 0; i < n; ++i)
+        force[i] = i == 0 && open ? 0.0 : k[e][i] * delta[i];
       if (tangent)
-        for (unsigned int i = 0; i < 3; ++i)
+        for (unsigned int i = 0; i < n; ++i)
           (*tangent)[i][i] = i == 0 && open ? 0.0 : k[e][i];
     }
 

@@ -72,7 +72,7 @@ namespace hysteron
     {
       std::array<double, 3> k{};
       std::array<double, 3> delta{}, force{}, trial_delta{}, trial_force{};
-      SpringLaw::Matrix     tangent;              ///< diag(k) for linear springs
+      SpringLaw<2>::Matrix     tangent;              ///< diag(k) for linear springs
       std::vector<double>   state, trial_state;   ///< the law's (hysteretic springs only)
       std::array<double, 6> B_n{}, B_t{}; ///< the rows n and t of B (the third is (0, 0, -1, 0, 0, 1))
       double                thickness  = 1;
@@ -154,7 +154,7 @@ namespace hysteron
       std::string
       summary(unsigned long steps, unsigned int outputs) const;
 
-      const Tessellation &
+      const Tessellation<2> &
       tessellation() const
       {
         return network;
@@ -369,7 +369,7 @@ namespace hysteron
       const Methods::Interface<2> &method;
 
       // Parameters.
-      Spacing                       spacing; ///< `Minimum distance` d(x), sampled by build_network()
+      Spacing<2>                       spacing; ///< `Minimum distance` d(x), sampled by build_network()
       double                        d_m = 0; ///< the constant d_m, or the smallest d of a function
       bool                          points_on_boundary = true;
       std::vector<dealii::Point<2>> extra_points;
@@ -377,7 +377,7 @@ namespace hysteron
       double                        shear_ratio  = 0;
       double                        moment_yield = 0.25;
       std::string                   spring_law_name;
-      std::unique_ptr<SpringLaw>    spring_law; ///< `RBSN/Spring law`
+      std::unique_ptr<SpringLaw<2>>    spring_law; ///< `RBSN/Spring law`
       Analysis                      analysis     = Analysis::quasi_static;
       double                        time_step    = 0;
       unsigned int                  n_increments = 100;
@@ -395,7 +395,7 @@ namespace hysteron
       unsigned long                 n_linear_iterations = 0;
 
       // The network: cells (rigid bodies), facets (springs), bodies.
-      Tessellation                          network;
+      Tessellation<2>                          network;
       std::vector<unsigned int>             cell_body;
       std::vector<double>                   cell_mass, cell_inertia; ///< about the nucleus
       std::vector<dealii::Tensor<1, 2>>     cell_offset;            ///< centroid - nucleus
@@ -434,7 +434,7 @@ namespace hysteron
       /// step (else the next assembly starts from zero), as does the assembly after
       /// max_incremental_updates updates. A checkpoint holds this state and the matrix, so
       /// that a resumed run takes the same steps bit for bit.
-      std::vector<SpringLaw::Matrix> assembled_tangent;
+      std::vector<SpringLaw<2>::Matrix> assembled_tangent;
       std::vector<bool>              facet_in_matrix;
       bool                           matrix_current = false;
       double                         matrix_dt      = 0;

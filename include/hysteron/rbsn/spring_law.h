@@ -21,29 +21,77 @@ namespace hysteron
 {
   namespace RBSN
   {
+    /// The number of springs of a facet: (normal, tangential, rotational) in 2D;
+    /// (normal, two shear, two bending, torsion) in 3D. Also the DoFs of a cell.
+    template <int dim>
+    inline constexpr unsigned int n_springs = dim == 2 ? 3 : 6;
+
+    /// The name of spring @p i of a facet ("normal", "tangential", "rotational" in 2D;
+    /// "normal", "first shear", "second shear", "first bending", "second bending",
+    /// "torsion" in 3D), for messages.
+    template <int dim>
+    inline const char *
+    spring_name(const unsigned int i)
+    {
+      static const char *names_2d[] = {"normal", "tangential", "rotational"};
+      static const char *names_3d[] = {"normal", "first shear", "second shear", "first bending",
+                                       "second bending", "torsion"};
+      return dim == 2 ? names_2d[i] : names_3d[i];
+    }
+
     /**
-     * The three springs of one facet as a spring law sees them when it sets the
-     * facet up: the elastic stiffnesses (Voronoi scaling, eq. 3.9), the facet's
-     * thickness and length, and `RBSN/Moment yield factor`.
+     * The springs of one facet as a spring law sees them when it sets the facet up:
+     * the elastic stiffnesses (Voronoi scaling, eq. 3.9 and its 3D form in
+     * doc/rbsn3d.md), the facet's section (area and second moments) and
+     * `RBSN/Moment yield factor`.
+     *
+     * The springs, in the order of SpringLaw<dim>::Vector:
+     * - 2D: normal, tangential, rotational (delta_n, delta_t, phi; F_n, F_t, M);
+     * - 3D: in the facet's axes (n, s_1, s_2), the normal spring, the shear springs along
+     *   s_1 and s_2, the bending springs about s_1 and s_2 and the torsion spring about n
+     *   (delta_n, delta_1, delta_2, phi_1, phi_2, phi_n; N, V_1, V_2, M_1, M_2, T).
      */
+    template <int dim>
     struct FacetSprings
     {
-      std::array<double, 3> k{};                   ///< k_n, k_t [N/m], k_phi [N m]
-      double                thickness           = 1; ///< t [m]
-      double                length              = 1; ///< l [m]
-      double                moment_yield_factor = 0.25;
+      std::array<double, n_springs<dim>> k{}; ///< [N/m] translations, [N m] rotations
+      /// The facet's area A [m^2] (2D: thickness t times length l).
+      double area = 1;
+      /// Second moments of the facet's area about its centroidal axes [m^4]: 2D, t l^3 / 12
+      /// (bending in the plane); 3D, I_1 about s_1 (int (x . s_2)^2 dA) and I_2 about s_2.
+      std::array<double, dim - 1> second_moments{};
+      double thickness = 1; ///< 2D: t [m]; 3D: not used (1)
+      double length    = 1; ///< 2D: l [m]; 3D: sqrt(A)
+      double moment_yield_factor = 0.25;
 
       /**
-       * The yield values of the three springs for the yield stress @p sigma_y [Pa]:
-       * F_y,n = sigma_y t l, F_y,t = sigma_y t l / sqrt(3) (von Mises in shear) and
-       * M_y = factor sigma_y t l^2 (factor 1/4: the plastic moment of the section).
+       * The yield values of the springs for the yield stress @p sigma_y [Pa]: the normal
+       * force sigma_y A, the shear forces sigma_y A / sqrt(3) (von Mises in shear), the
+       * bending moments f sigma_y A sqrt(12 I / A) and (3D) the torque
+       * f (sigma_y / sqrt(3)) A sqrt(12 J / A), J = I_1 + I_2, with f = `Moment yield
+       * factor`. For a rectangular section b x h bent about its b side, sqrt(12 I / A) = h
+       * and f = 1/4 gives the plastic moment sigma_y b h^2 / 4; in 2D this is
+       * f sigma_y t l^2. The torque with f = 1/4 is within 8 % of the plastic torque of a
+       * square and of a circular section (doc/rbsn3d.md).
        */
-      std::array<double, 3>
+      std::array<double, n_springs<dim>>
       yield_values(const double sigma_y) const
       {
-        return {{sigma_y * thickness * length,
-                 sigma_y * thickness * length / std::sqrt(3.0),
-                 moment_yield_factor * sigma_y * thickness * length * length}};
+        if constexpr (dim == 2)
+          return {{sigma_y * thickness * length,
+                   sigma_y * thickness * length / std::sqrt(3.0),
+                   moment_yield_factor * sigma_y * thickness * length * length}};
+        const double                       shear = sigma_y / std::sqrt(3.0);
+        std::array<double, n_springs<dim>> y{};
+        y[0] = sigma_y * area;
+        for (unsigned int i = 1; i < dim; ++i)
+          y[i] = shear * area;
+        for (unsigned int i = 0; i + 1 < dim; ++i)
+          y[dim + i] = moment_yield_factor * sigma_y * area * std::sqrt(12 * second_moments[i] / area);
+        if constexpr (dim == 3)
+          y[5] = moment_yield_factor * shear * area *
+                 std::sqrt(12 * (second_moments[0] + second_moments[1]) / area);
+        return y;
       }
     };
 
@@ -91,16 +139,17 @@ namespace hysteron
     };
 
     /**
-     * A facet spring law: the forces F = (F_n, F_t, M) of a facet's normal,
-     * tangential and rotational springs as a function of their deformations
-     * delta = (delta_n, delta_t, phi) and of a per-facet state (a flat array of
-     * n_state_variables() doubles, which the network stores, commits and
-     * checkpoints). Laws register by name and are chosen by `RBSN/Spring law`.
+     * A facet spring law: the forces F of a facet's springs (2D: F_n, F_t, M of the
+     * normal, tangential and rotational springs; 3D: N, V_1, V_2, M_1, M_2, T, see
+     * FacetSprings) as a function of their deformations delta (2D: delta_n, delta_t,
+     * phi; 3D: delta_n, delta_1, delta_2, phi_1, phi_2, phi_n) and of a per-facet state
+     * (a flat array of n_state_variables() doubles, which the network stores, commits
+     * and checkpoints). Laws register by name and are chosen by `RBSN/Spring law`.
      *
      * One object serves the whole network: setup_facet() is called for every
      * facet in order and the law keeps what it precomputes per facet (indexed by
      * the facet number); update() is called once per facet and evaluation (one
-     * virtual call, the law's own loop over the three springs inside).
+     * virtual call, the law's own loop over the springs inside).
      *
      * Facets whose springs the law declares linear (setup_facet() returns false)
      * are F = k delta, handled by the network without calling the law; so are all
@@ -112,13 +161,16 @@ namespace hysteron
      * Writing a new law: derive from this class, implement the pure virtual
      * functions, optionally a static declare_parameters(ParameterHandler &)
      * (entries inside `subsection RBSN`) and parse_parameters(), and register it
-     * with HYSTERON_REGISTER_SPRING_LAW(ClassName, "name", "description").
+     * with HYSTERON_REGISTER_SPRING_LAW(ClassName, "name", "description"), where
+     * ClassName is a class template on dim (registered for 2D and 3D networks).
      */
+    template <int dim>
     class SpringLaw
     {
     public:
-      using Vector = std::array<double, 3>; ///< (delta_n, delta_t, phi) or (F_n, F_t, M)
-      using Matrix = dealii::Tensor<2, 3>;  ///< D = dF / d delta
+      static constexpr unsigned int n = n_springs<dim>;
+      using Vector = std::array<double, n>; ///< deformations delta or forces F
+      using Matrix = dealii::Tensor<2, n>;  ///< D = dF / d delta
 
       virtual ~SpringLaw() = default;
 
@@ -141,7 +193,7 @@ namespace hysteron
       /// Why the law cannot join cells of material @p material ("" if it can); an error
       /// at `RBSN/Spring law` when a body has such a material.
       virtual std::string
-      unsupported(const Material::Interface<2> &material) const
+      unsupported(const Material::Interface<dim> &material) const
       {
         (void)material;
         return "";
@@ -154,17 +206,17 @@ namespace hysteron
        * (n_state_variables() doubles) and return true.
        */
       virtual bool
-      setup_facet(unsigned int                  e,
-                  const FacetSprings           &springs,
-                  const Material::Interface<2> &a,
-                  const Material::Interface<2> &b,
-                  double                       *state) = 0;
+      setup_facet(unsigned int                    e,
+                  const FacetSprings<dim>        &springs,
+                  const Material::Interface<dim> &a,
+                  const Material::Interface<dim> &b,
+                  double                         *state) = 0;
 
       /// Whether the tangents of update() are the consistent derivatives of its forces for
       /// cells of @p material (else Newton converges linearly and the user is warned); the
       /// default asks the material.
       virtual bool
-      has_consistent_tangent(const Material::Interface<2> &material) const
+      has_consistent_tangent(const Material::Interface<dim> &material) const
       {
         return material.has_consistent_tangent();
       }
@@ -228,19 +280,22 @@ namespace hysteron
       }
     };
 
-    using SpringLawRegistry = Plugins::Registry<SpringLaw>;
+    template <int dim>
+    using SpringLawRegistry = Plugins::Registry<SpringLaw<dim>>;
 
     /// The Bouc-Wen parameters of the springs between cells of materials @p a and @p b
     /// (those of @p a), or null unless both materials give Bouc-Wen springs.
+    template <int dim>
     inline const Material::BoucWenParameters *
-    bouc_wen_springs(const Material::Interface<2> &a, const Material::Interface<2> &b)
+    bouc_wen_springs(const Material::Interface<dim> &a, const Material::Interface<dim> &b)
     {
       return b.spring_behaviour().bouc_wen ? a.spring_behaviour().bouc_wen : nullptr;
     }
 
     /// The yield stress sigma_y [Pa] of a facet between two Bouc-Wen materials: the smaller one.
+    template <int dim>
     inline double
-    facet_yield_stress(const Material::Interface<2> &a, const Material::Interface<2> &b)
+    facet_yield_stress(const Material::Interface<dim> &a, const Material::Interface<dim> &b)
     {
       return std::min(a.spring_behaviour().bouc_wen->yield_stress,
                       b.spring_behaviour().bouc_wen->yield_stress);
@@ -256,12 +311,9 @@ namespace hysteron
   } // namespace RBSN
 } // namespace hysteron
 
-/// Register the spring law class @p classname under @p name (a value of `RBSN/Spring law`).
-#define HYSTERON_REGISTER_SPRING_LAW(classname, name, description)                            \
-  namespace                                                                                  \
-  {                                                                                          \
-    const ::hysteron::Plugins::Registration<::hysteron::RBSN::SpringLaw, classname>           \
-      HYSTERON_PLUGIN_CONCAT(hysteron_spring_law_registration_, __LINE__)(name, description); \
-  }
+/// Register the spring law class template @p classname (on dim) under @p name (a value of
+/// `RBSN/Spring law`) for 2D and 3D networks.
+#define HYSTERON_REGISTER_SPRING_LAW(classname, name, description) \
+  HYSTERON_REGISTER_DIM_PLUGIN(::hysteron::RBSN::SpringLaw, classname, name, description)
 
 #endif

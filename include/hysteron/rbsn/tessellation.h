@@ -3,6 +3,7 @@
 
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/point.h>
+#include <deal.II/base/symmetric_tensor.h>
 #include <deal.II/base/tensor.h>
 #include <deal.II/base/timer.h>
 
@@ -28,6 +29,7 @@ namespace hysteron
      * d is smaller). sample() evaluates it over the bodies for its bounds, its
      * gradient and the predicted number of points.
      */
+    template <int dim>
     class Spacing
     {
     public:
@@ -35,13 +37,13 @@ namespace hysteron
       Spacing(const double d_m = 0);
 
       /// d(x) from @p function; @p expression and @p where name it in errors.
-      Spacing(std::function<double(const dealii::Point<2> &)> function,
-              const std::string                              &expression,
-              const std::string                              &where);
+      Spacing(std::function<double(const dealii::Point<dim> &)> function,
+              const std::string                                &expression,
+              const std::string                                &where);
 
       /// d(p); throws InputError(where) naming the expression and p unless d(p) > 0 and finite.
       double
-      operator()(const dealii::Point<2> &p) const;
+      operator()(const dealii::Point<dim> &p) const;
 
       bool
       is_constant() const
@@ -50,25 +52,30 @@ namespace hysteron
       }
 
       /**
-       * Evaluate d at the midpoints of a grid of about 2^16 square cells over the
-       * bounding box of @p bodies (the points in a body): the bounds of d, its
-       * largest gradient (finite differences of neighbouring samples) and the
-       * predicted number of points of a saturated set, 0.68 int 1/d^2 dA
-       * (midpoint rule; exact for a constant d up to the area's estimate).
+       * Evaluate d at the midpoints of a grid of about 2^16 square cells (2D) or 2^18
+       * cubes (3D) over the bounding box of @p bodies (the points in a body): the
+       * bounds of d, its largest gradient (finite differences of neighbouring samples)
+       * and the predicted number of points of a saturated set, 0.68 int 1/d^2 dA in 2D
+       * and 0.70 int 1/d^3 dV in 3D (midpoint rule; exact for a constant d up to the
+       * measure's estimate; the 3D coefficient is the jamming density of random
+       * sequential addition of spheres of diameter d, 0.38 = (pi/6) n d^3).
        */
       void
-      sample(const std::vector<const Geometry::Region<2> *> &bodies);
+      sample(const std::vector<const Geometry::Region<dim> *> &bodies);
+
+      /// The density coefficient of a saturated set: n = coefficient int d^-dim.
+      static constexpr double density = dim == 2 ? 0.68 : 0.70;
 
       /// The smallest and largest d over the bodies (sampled; the constant).
       double min = 0, max = 0;
       /// The largest |grad d| over the bodies (sampled; 0 for a constant).
       double gradient = 0;
-      /// 0.68 int 1/d^2 dA over the bodies (after sample()).
+      /// density int d^-dim over the bodies (after sample()).
       double predicted_points = 0;
 
     private:
-      std::function<double(const dealii::Point<2> &)> function;
-      std::string                                     expression, where;
+      std::function<double(const dealii::Point<dim> &)> function;
+      std::string                                       expression, where;
     };
 
     /**
@@ -77,18 +84,25 @@ namespace hysteron
      * until it is saturated, each keeping |p - q| >= min(d(p), d(q)) from every
      * point q (Poisson-disk sampling, seeded: the same seed gives the same
      * points). A saturated random sequential addition approaches n = 0.68 A / d^2
-     * points in an area A (Bolander & Saito; dissertation §3.3.3). Fixed points
-     * closer than that to each other are kept. @p d must have been sampled over
-     * (at least) @p domain; its bounds only set the background grid, so a
-     * sampling that misses an extreme of d costs time, never the distance rule.
-     * Bridson's front grows from the points; when it dies out, every background
-     * grid cell that no point's exclusion disk covers gets 30 random trials, and
+     * points in an area A (Bolander & Saito; dissertation §3.3.3), 0.70 V / d^3 in a
+     * volume V. Fixed points closer than that to each other are kept. @p d must have
+     * been sampled over (at least) @p domain; its bounds only set the background
+     * grid, so a sampling that misses an extreme of d costs time, never the distance
+     * rule. Bridson's front grows from the points; when it dies out, every background
+     * grid cell that no point's exclusion ball covers gets 30 random trials, and
      * the front restarts from each point found: O(n) in all.
      */
     std::vector<dealii::Point<2>>
     poisson_disk_points(const Geometry::Region<2>           &domain,
-                        const Spacing                       &d,
+                        const Spacing<2>                    &d,
                         const std::vector<dealii::Point<2>> &fixed,
+                        const std::uint64_t                  seed,
+                        const std::string                   &where);
+
+    std::vector<dealii::Point<3>>
+    poisson_disk_points(const Geometry::Region<3>           &domain,
+                        const Spacing<3>                    &d,
+                        const std::vector<dealii::Point<3>> &fixed,
                         const std::uint64_t                  seed,
                         const std::string                   &where);
 
@@ -109,7 +123,22 @@ namespace hysteron
      * loads act there).
      */
     std::vector<dealii::Point<2>>
-    boundary_points(const Geometry::Region<2> &domain, const Spacing &spacing, const double boundary_h);
+    boundary_points(const Geometry::Region<2> &domain, const Spacing<2> &spacing, const double boundary_h);
+
+    /**
+     * 3D: points on the boundary of the polyhedral domain (the region with its
+     * curved primitives as polyhedra at resolution @p boundary_h, see voronoi()):
+     * the corners, points along the edges (where two faces meet at more than 20
+     * degrees) at most the local d apart, and Poisson-disk points on every face
+     * keeping min(d(p), d(q)) from the others, so that the cells of the boundary
+     * have their nuclei on it (supports and loads act there). Deterministic for
+     * a @p seed.
+     */
+    std::vector<dealii::Point<3>>
+    boundary_points(const Geometry::Region<3> &domain,
+                    const Spacing<3>          &spacing,
+                    const double               boundary_h,
+                    const std::uint64_t        seed = 0);
 
     /**
      * Console lines of a large network's set-up, one per stage: "rbsn: <what> in
@@ -141,20 +170,30 @@ namespace hysteron
     };
 
     /// A Voronoi cell clipped to the domain: a rigid body.
-    struct Cell
+    template <int dim>
+    struct Cell;
+
+    /// The common facet of two cells: one element with its springs.
+    template <int dim>
+    struct Facet;
+
+    template <>
+    struct Cell<2>
     {
       dealii::Point<2> nucleus;  ///< the computational point (its DoFs u, v, theta)
       double           area = 0; ///< of the clipped cell [m^2]
       dealii::Point<2> centroid;
       double           polar_moment = 0; ///< integral of |x - centroid|^2 over the cell [m^4]
+      /// The largest distance of a point of the clipped cell from the nucleus [m].
+      double reach = 0;
       /// The outline of the clipped cell: closed loops of vertices (output).
       std::vector<std::vector<dealii::Point<2>>> outline;
       /// The pieces of the domain's boundary that bound this cell (tractions act there).
       std::vector<std::array<dealii::Point<2>, 2>> boundary;
     };
 
-    /// The common facet of two cells: one element with its three springs.
-    struct Facet
+    template <>
+    struct Facet<2>
     {
       unsigned int           a = 0, b = 0;  ///< the cells, a < b
       dealii::Point<2>       p3, p4;        ///< end points (of the longest piece in the domain)
@@ -165,10 +204,55 @@ namespace hysteron
       dealii::Tensor<1, 2>   normal;        ///< from a to b
     };
 
+    /**
+     * A 3D cell: the Voronoi polyhedron of its nucleus clipped to the polyhedral
+     * domain. The clipped cell is a union of disjoint convex polyhedra (one for a
+     * cell that no subtracted primitive cuts), each given by its faces.
+     */
+    template <>
+    struct Cell<3>
+    {
+      dealii::Point<3> nucleus;    ///< the computational point (its DoFs u, theta)
+      double           volume = 0; ///< of the clipped cell [m^3]
+      dealii::Point<3> centroid;
+      /// int (x - centroid) (x - centroid)^T dV over the cell [m^5] (the inertia tensor
+      /// per unit density is trace(S) I - S).
+      dealii::SymmetricTensor<2, 3> second_moment;
+      /// The largest distance of a point of the clipped cell from the nucleus [m].
+      double reach = 0;
+      /// The convex pieces of the clipped cell: for each, its faces, each a planar loop
+      /// of vertices counter-clockwise seen from outside (output).
+      std::vector<std::vector<std::vector<dealii::Point<3>>>> pieces;
+      /// The parts of the domain's boundary that bound this cell (tractions act there):
+      /// planar loops counter-clockwise seen from outside the domain.
+      std::vector<std::vector<dealii::Point<3>>> boundary;
+    };
+
+    template <>
+    struct Facet<3>
+    {
+      unsigned int     a = 0, b = 0; ///< the cells, a < b
+      /// The springs' location: the centroid of the facet's area in the domain.
+      dealii::Point<3> midpoint;
+      double           area     = 0; ///< A: in the domain (all pieces) [m^2]
+      double           distance = 0; ///< h = |x_b - x_a|
+      double           h_a = 0, h_b = 0; ///< distances of the nuclei from the facet's plane
+      dealii::Tensor<1, 3> normal;       ///< unit, from a to b
+      /// The principal axes of the facet's second moment of area (in its plane; (normal,
+      /// axis_1, axis_2) right-handed), and the principal second moments about the
+      /// centroid: I_1 = int (xi . axis_2)^2 dA about axis_1, I_2 = int (xi . axis_1)^2 dA
+      /// about axis_2 [m^4] (xi from the centroid), I_1 >= I_2.
+      dealii::Tensor<1, 3> axis_1, axis_2;
+      double               second_moment_1 = 0, second_moment_2 = 0;
+      /// The facet's pieces in the domain: planar loops (output).
+      std::vector<std::vector<dealii::Point<3>>> polygons;
+    };
+
+    template <int dim>
     struct Tessellation
     {
-      std::vector<Cell>  cells;
-      std::vector<Facet> facets;
+      std::vector<Cell<dim>>  cells;
+      std::vector<Facet<dim>> facets;
     };
 
     /**
@@ -183,12 +267,38 @@ namespace hysteron
      * pieces by a hole keeps their total length and their mean midpoint.
      * Deterministic. Throws InputError(@p where) if a nucleus lies outside the
      * domain or two coincide.
+     *
+     * With @p wanted (one flag per nucleus) only the cells of the flagged nuclei are
+     * built (the others stay empty), and the facets are those between a flagged
+     * nucleus a and any b > a, each from the cell of a: a cell's geometry depends only
+     * on the nuclei near it, so a rank of a distributed network builds its own cells
+     * from its nuclei and a halo of nuclei around them (Cell::reach tells whether the
+     * halo was wide enough: every nucleus within 2 reach of the nucleus must be given).
+     * The facets are sorted by (a, b).
      */
-    Tessellation
-    voronoi(const std::vector<dealii::Point<2>>          &nuclei,
+    Tessellation<2>
+    voronoi(const std::vector<dealii::Point<2>>            &nuclei,
             const std::vector<const Geometry::Region<2> *> &bodies,
-            const double                                   boundary_h,
-            const std::string                             &where);
+            const double                                    boundary_h,
+            const std::string                              &where,
+            const std::vector<bool>                        &wanted = {});
+
+    /**
+     * 3D: the Voronoi cells of @p nuclei (from CGAL's 3D Delaunay triangulation,
+     * each cell the intersection of the half-spaces of the bisectors of its Delaunay
+     * neighbours) clipped exactly to the union of @p bodies, whose curved primitives
+     * (spheres, cylinders) are polyhedra with edges of at most @p boundary_h. Each
+     * cell's volume, centroid and second moment are exact integrals over its convex
+     * pieces; a facet is the common face of two cells inside the domain, with its
+     * area, centroid and principal second moments over all its pieces. @p wanted, the
+     * order of the facets and the errors as in 2D.
+     */
+    Tessellation<3>
+    voronoi(const std::vector<dealii::Point<3>>            &nuclei,
+            const std::vector<const Geometry::Region<3> *> &bodies,
+            const double                                    boundary_h,
+            const std::string                              &where,
+            const std::vector<bool>                        &wanted = {});
   } // namespace RBSN
 } // namespace hysteron
 

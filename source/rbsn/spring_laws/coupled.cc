@@ -16,9 +16,14 @@ namespace hysteron
        * hysteretic forces F^h_i = (1 - a) k_i z_i with associated flow, and a full
        * 3 x 3 tangent D_t. The state is z = (z_n, z_t, z_phi).
        */
-      class Coupled : public SpringLaw
+      template <int dim>
+      class Coupled : public SpringLaw<dim>
       {
       public:
+        using typename SpringLaw<dim>::Vector;
+        using typename SpringLaw<dim>::Matrix;
+        static constexpr unsigned int n = SpringLaw<dim>::n;
+
         unsigned int
         n_state_variables() const override
         {
@@ -26,7 +31,7 @@ namespace hysteron
         }
 
         std::string
-        unsupported(const Material::Interface<2> &material) const override
+        unsupported(const Material::Interface<dim> &material) const override
         {
           const auto behaviour = material.spring_behaviour();
           return behaviour.bouc_wen ? Material::BoucWenInteraction::unsupported(*behaviour.bouc_wen) :
@@ -35,16 +40,19 @@ namespace hysteron
 
         bool
         setup_facet(const unsigned int            e,
-                    const FacetSprings           &springs,
-                    const Material::Interface<2> &a,
-                    const Material::Interface<2> &b,
+                    const FacetSprings<dim>      &springs,
+                    const Material::Interface<dim> &a,
+                    const Material::Interface<dim> &b,
                     double                       *state) override
         {
-          const Material::BoucWenParameters *prm = bouc_wen_springs(a, b);
+          const Material::BoucWenParameters *prm = bouc_wen_springs<dim>(a, b);
           if (prm == nullptr)
             return false;
           Facet &facet = facets(e);
-          facet.law.reinit(*prm, springs.k, springs.yield_values(facet_yield_stress(a, b)));
+          if constexpr (dim == 2)
+            facet.law.reinit(*prm, springs.k, springs.yield_values(facet_yield_stress<dim>(a, b)));
+          else
+            throw InputError("RBSN/Spring law", "the coupled law is two-dimensional");
           facet.law.initialize_state(state);
           facet.k = springs.k;
           facet.a = prm->post_yield_ratio;
@@ -60,7 +68,8 @@ namespace hysteron
         {
           try
             {
-              facets[e].law.update(increment, force, state, tangent);
+              if constexpr (dim == 2)
+                facets[e].law.update(increment, force, state, tangent);
             }
           catch (const RuntimeError &error)
             {

@@ -21,32 +21,37 @@ namespace hysteron
        * State of spring i: state[2 i] = delta^p_i, state[2 i + 1] = |F_i| / F_y,i
        * (the H1 output: 1 at yield).
        */
-      class ElasticPerfectlyPlastic : public SpringLaw
+      template <int dim>
+      class ElasticPerfectlyPlastic : public SpringLaw<dim>
       {
       public:
+        using typename SpringLaw<dim>::Vector;
+        using typename SpringLaw<dim>::Matrix;
+        static constexpr unsigned int n = SpringLaw<dim>::n;
+
         unsigned int
         n_state_variables() const override
         {
-          return 6;
+          return 2 * n;
         }
 
         bool
         setup_facet(const unsigned int            e,
-                    const FacetSprings           &springs,
-                    const Material::Interface<2> &a,
-                    const Material::Interface<2> &b,
+                    const FacetSprings<dim>      &springs,
+                    const Material::Interface<dim> &a,
+                    const Material::Interface<dim> &b,
                     double                       *state) override
         {
-          if (bouc_wen_springs(a, b) == nullptr)
+          if (bouc_wen_springs<dim>(a, b) == nullptr)
             return false;
-          facets(e) = {springs.k, springs.yield_values(facet_yield_stress(a, b))};
-          std::fill(state, state + 6, 0.0);
+          facets(e) = {springs.k, springs.yield_values(facet_yield_stress<dim>(a, b))};
+          std::fill(state, state + 2 * n, 0.0);
           return true;
         }
 
         /// The return map's tangent is exact, whatever the material's Bouc-Wen integrator.
         bool
-        has_consistent_tangent(const Material::Interface<2> &) const override
+        has_consistent_tangent(const Material::Interface<dim> &) const override
         {
           return true;
         }
@@ -64,8 +69,8 @@ namespace hysteron
                double            *state,
                Matrix            *tangent) const override
         {
-          const Facet &f = facets[e];
-          for (unsigned int i = 0; i < 3; ++i)
+          const Facet &f = this->facets[e];
+          for (unsigned int i = 0; i < n; ++i)
             {
               const double trial = force[i] + f.k[i] * increment[i];
               const bool   yields = std::abs(trial) > f.yield[i];

@@ -18,30 +18,35 @@ namespace hysteron
        * i lies at state[3 i] (BoucWenUniaxial::max_n_state_variables each: z, and eta
        * and e_h with degradation); the tangent is diagonal.
        */
-      class Uncoupled : public SpringLaw
+      template <int dim>
+      class Uncoupled : public SpringLaw<dim>
       {
       public:
+        using typename SpringLaw<dim>::Vector;
+        using typename SpringLaw<dim>::Matrix;
+        static constexpr unsigned int n = SpringLaw<dim>::n;
+
         static constexpr unsigned int stride = Material::BoucWenUniaxial::max_n_state_variables;
 
         unsigned int
         n_state_variables() const override
         {
-          return 3 * stride;
+          return n * stride;
         }
 
         bool
         setup_facet(const unsigned int            e,
-                    const FacetSprings           &springs,
-                    const Material::Interface<2> &a,
-                    const Material::Interface<2> &b,
+                    const FacetSprings<dim>      &springs,
+                    const Material::Interface<dim> &a,
+                    const Material::Interface<dim> &b,
                     double                       *state) override
         {
-          const Material::BoucWenParameters *prm = bouc_wen_springs(a, b);
+          const Material::BoucWenParameters *prm = bouc_wen_springs<dim>(a, b);
           if (prm == nullptr)
             return false;
           auto      &facet = laws(e);
-          const auto yield = springs.yield_values(facet_yield_stress(a, b));
-          for (unsigned int i = 0; i < 3; ++i)
+          const auto yield = springs.yield_values(facet_yield_stress<dim>(a, b));
+          for (unsigned int i = 0; i < n; ++i)
             {
               facet[i].reinit(*prm, springs.k[i], yield[i]);
               facet[i].initialize_state(state + stride * i);
@@ -65,7 +70,7 @@ namespace hysteron
           // Every spring is advanced even if one fails, so that the trial state is the
           // same as spring-by-spring; the last failure is reported.
           std::string cause, spring;
-          for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int i = 0; i < n; ++i)
             try
               {
                 laws[e][i].update(increment[i], force[i], state + stride * i,
@@ -74,8 +79,7 @@ namespace hysteron
             catch (const RuntimeError &error)
               {
                 cause  = error.what();
-                spring = std::string("the ") +
-                         (i == 0 ? "normal" : i == 1 ? "tangential" : "rotational") + " spring";
+                spring = std::string("the ") + spring_name<dim>(i) + " spring";
               }
           if (!cause.empty())
             throw SpringFailure(cause, spring);
@@ -104,14 +108,14 @@ namespace hysteron
           return "";
         }
 
-        UniaxialSpring
+        typename SpringLaw<dim>::UniaxialSpring
         uniaxial_spring(const unsigned int e, const unsigned int i) const override
         {
           return {&laws[e][i], stride * i};
         }
 
       private:
-        PerFacet<std::array<Material::BoucWenUniaxial, 3>> laws;
+        PerFacet<std::array<Material::BoucWenUniaxial, n>> laws;
       };
     } // namespace
   } // namespace RBSN
