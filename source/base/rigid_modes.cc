@@ -42,12 +42,14 @@ namespace hysteron
 
   template <int dim>
   void
-  RigidModeCheck<dim>::add_rotation(const unsigned int part)
+  RigidModeCheck<dim>::add_rotation(const unsigned int part, const unsigned int axis)
   {
     static_assert(dim == 2 || dim == 3, "");
-    // A rotation DoF theta of a rigid cell: the rotation mode moves it by 1 (per L).
-    double *g = gram.data() + part * n_modes * n_modes;
-    g[(n_modes - 1) * n_modes + n_modes - 1] += 1;
+    // A rotation DoF theta_axis of a rigid cell: the rotation mode about that axis moves
+    // it by 1 (per L).
+    const unsigned int k = dim + axis;
+    double            *g = gram.data() + part * n_modes * n_modes;
+    g[k * n_modes + k] += 1;
   }
 
   template <int dim>

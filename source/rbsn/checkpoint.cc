@@ -1,6 +1,7 @@
 // The RBSN's part of a checkpoint: the DoF vectors, every facet's springs (converged
 // and trial state, tangent, broken or not), the increment control and the work sums.
-// Every rank holds the whole network, so every rank writes (and reads) the same.
+// Every rank writes (and reads) its own cells' DoFs and its own facets; a checkpoint of
+// N ranks resumes on N ranks, which build the same network.
 #include <hysteron/rbsn/model.h>
 
 #include <Epetra_CrsMatrix.h>
@@ -9,11 +10,12 @@ namespace hysteron
 {
   namespace RBSN
   {
+    template <int dim>
     void
-    Model::save(CheckpointWriter &out) const
+    Model<dim>::save(CheckpointWriter &out) const
     {
       const auto put_vector = [&](const Vector &x) {
-        out.put(std::vector<double>(x.begin(), x.end()));
+        out.put(std::vector<double>(x.begin(), x.begin() + x.locally_owned_size()));
       };
       out.section("rbsn vectors");
       out.put<std::uint64_t>(u.size());
@@ -64,14 +66,16 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Model::load(CheckpointReader &in)
+    Model<dim>::load(CheckpointReader &in)
     {
       const auto get_vector = [&](Vector &x) {
         std::vector<double> values;
         in.get(values);
-        if (values.size() != x.size())
+        if (values.size() != x.locally_owned_size())
           in.refuse("the network has another number of DoFs than the checkpoint's");
+        x = 0;
         std::copy(values.begin(), values.end(), x.begin());
       };
       in.section("rbsn vectors");
@@ -80,6 +84,8 @@ namespace hysteron
                   "parameters and Random seed give the same network)");
       for (Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
         get_vector(*x);
+      for (Vector *x : {&u, &u_trial, &v, &a})
+        x->update_ghost_values();
       in.section("rbsn spring laws");
       if (in.get<std::uint64_t>() != springs.size())
         in.refuse("the network has another number of facets than the checkpoint's");
@@ -165,8 +171,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     std::vector<double>
-    Model::matrix_values() const
+    Model<dim>::matrix_values() const
     {
       std::vector<double> values;
       for_each_matrix_value(trilinos_system(), parallel_matrix, matrix, [&](const double v) { values.push_back(v); });
@@ -175,8 +182,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Model::set_matrix_values(const std::vector<double> &values)
+    Model<dim>::set_matrix_values(const std::vector<double> &values)
     {
       // The pattern is rebuilt by set-up as it was: the values go back in the same order.
       std::size_t k     = 0;
@@ -189,5 +197,8 @@ namespace hysteron
       if (k != values.size())
         throw error;
     }
+
+    template class Model<2>;
+    template class Model<3>;
   } // namespace RBSN
 } // namespace hysteron

@@ -9,6 +9,8 @@
 #include <hysteron/scene/output_column.h>
 #include <hysteron/rbsn/rbsn.h>
 
+#include "rbsn/collective.h"
+
 #include <cmath>
 #include <cstdlib>
 #include <iomanip>
@@ -20,8 +22,9 @@ namespace hysteron
 {
   namespace RBSN
   {
+    template <int dim>
     void
-    Model::declare_parameters(dealii::ParameterHandler &prm)
+    Model<dim>::declare_parameters(dealii::ParameterHandler &prm)
     {
       using namespace dealii;
       prm.enter_subsection("RBSN");
@@ -32,9 +35,10 @@ namespace hysteron
                           "d_m [m] > 0: random nuclei keep at least this distance from each other "
                           "(Poisson-disk sampling up to saturation, about 0.68 A / d_m^2 points in "
                           "an area A; dissertation §3.3.3). A function of x, y gives a graded "
-                          "network (e.g. 0.002 + 0.02 * abs(x - 1), finer where d is smaller): a new "
-                          "point p keeps |p - q| >= min(d(p), d(q)) from every point q, about "
-                          "0.68 int 1/d^2 dA points; d must be finite and > 0 in the bodies and "
+                          "network (e.g. 0.002 + 0.02 * abs(x - 1), finer where d is smaller; of x, y, z "
+                          "in 3D): a new point p keeps |p - q| >= min(d(p), d(q)) from every point "
+                          "q, about 0.68 int 1/d^2 dA points (0.70 int 1/d^3 dV in 3D); d must be "
+                          "finite and > 0 in the bodies and "
                           "should vary slowly (|grad d| well below 1; doc/rbsn.md).");
         prm.declare_entry("Points on the boundary",
                           "true",
@@ -45,34 +49,38 @@ namespace hysteron
         prm.declare_entry("Additional points",
                           "",
                           Patterns::Anything(),
-                          "Nuclei placed by the user [m], 'x, y; x, y; ...' (supports, load "
-                          "points); the random points keep d_m from them.");
+                          "Nuclei placed by the user [m], 'x, y; x, y; ...' ('x, y, z; ...' in 3D; "
+                          "supports, load points); the random points keep d_m from them.");
         prm.declare_entry("Curved boundary resolution",
                           "0",
                           Patterns::Double(),
-                          "Segment length [m] of curved boundaries (disks as polygons), >= 0; 0: "
+                          "Segment length [m] of curved boundaries (disks as polygons; in 3D the "
+                          "edges of the polyhedra that stand for spheres and cylinders), >= 0; 0: "
                           "d_m / 4 (the smallest d_m over the bodies for a graded network).");
         prm.declare_entry("Shear stiffness ratio",
                           "0",
                           Patterns::Double(),
-                          "k_t / k_n, >= 0; 0: from the material, k_t = G t l / h and k_n = "
-                          "E' t l / h (eq. 3.9; E' = E / (1 - nu^2) in plane stress). 1 makes the "
-                          "network elastically uniform under any uniform strain (with nu = 0).");
+                          "k_t / k_n, >= 0; 0: from the material, k_t = G A / h and k_n = "
+                          "E' A / h (eq. 3.9; A = t l in 2D, the facet's area in 3D; E' = "
+                          "E / (1 - nu^2) in plane stress, lambda + 2 mu in plane strain and 3D). 1 "
+                          "makes the network elastically uniform under any uniform strain (with nu = 0).");
         prm.declare_entry("Moment yield factor",
                           "0.25",
                           Patterns::Double(),
                           "The rotational spring yields at M_y = factor sigma_y t l^2 (0.25: the "
                           "plastic moment of the facet's section), > 0. The normal and tangential "
-                          "springs yield at sigma_y t l and sigma_y t l / sqrt(3).");
+                          "springs yield at sigma_y t l and sigma_y t l / sqrt(3). 3D: the bending "
+                          "springs at factor sigma_y A sqrt(12 I / A), the torsion spring at factor "
+                          "sigma_y / sqrt(3) A sqrt(12 J / A) (doc/rbsn3d.md).");
         prm.declare_entry("Spring law",
                           "uncoupled",
-                          Patterns::Selection(SpringLawRegistry<2>::pattern_string()),
+                          Patterns::Selection(SpringLawRegistry<dim>::pattern_string()),
                           "The law of the facet springs, a registered plugin (doc/rbsn.md; plugins "
                           "from Additional shared libraries too). The built-in laws take the facets "
                           "between Bouc-Wen cells (linear-elastic ones have linear springs); "
                           "Analysis = static has linear springs throughout:" +
-                            SpringLawRegistry<2>::documentation());
-        SpringLawRegistry<2>::declare_parameters(prm);
+                            SpringLawRegistry<dim>::documentation());
+        SpringLawRegistry<dim>::declare_parameters(prm);
         prm.declare_entry("Analysis",
                           "quasi-static",
                           Patterns::Selection("static|quasi-static|implicit dynamics|variable order"),
@@ -114,7 +122,8 @@ namespace hysteron
                           "UMFPACK",
                           Patterns::Selection("UMFPACK|Amesos_Klu|Amesos_Mumps"),
                           "Under mpirun (more than one rank) the cells are split over the ranks "
-                          "(METIS), each rank assembles its facets, and the distributed tangent "
+                          "(coordinate bisection), each rank builds and assembles its cells and "
+                          "facets, and the distributed tangent "
                           "goes to: UMFPACK (the default: gathered on rank 0 and factorized there "
                           "with the symbolic analysis kept, as on one rank; reproducible bit for "
                           "bit), Amesos_Klu (Trilinos, gathered on one rank; reproducible) or "
@@ -125,9 +134,9 @@ namespace hysteron
                           Patterns::Selection("direct|cg|gmres"),
                           "direct: UMFPACK on one rank, `Distributed direct solver` on several; "
                           "cg (the uncoupled and elastic springs: a symmetric tangent) or gmres: "
-                          "Krylov iterations with ML algebraic multigrid that knows the three "
-                          "rigid-body modes of every cell (translations and the rotation about the "
-                          "origin), to `Linear solver tolerance` of the residual.");
+                          "Krylov iterations with ML algebraic multigrid that knows the rigid-body "
+                          "modes of every cell (3 in 2D, 6 in 3D: translations and rotations about "
+                          "the network's centre), to `Linear solver tolerance` of the residual.");
         prm.declare_entry("Linear solver tolerance",
                           "1e-10",
                           Patterns::Double(),
@@ -140,9 +149,9 @@ namespace hysteron
         prm.declare_entry("Write spring table",
                           "false",
                           Patterns::Bool(),
-                          "Write springs.csv at the end: every facet (cells, midpoint, length, "
-                          "distance, stiffnesses, forces, H1 of the three springs (Spring law = "
-                          "coupled: the facet's Phi^n in all three), broken).");
+                          "Write springs.csv at the end: every facet (cells, midpoint, length or "
+                          "area, distance, stiffnesses, deformations, forces, H1 of its springs "
+                          "(Spring law = coupled: the facet's Phi^n in all), broken).");
         prm.enter_subsection("Newton");
         NewtonParameters::declare_parameters(prm);
         prm.leave_subsection();
@@ -155,13 +164,13 @@ namespace hysteron
           prm.declare_entry("Tensile strength",
                             "0",
                             Patterns::Double(),
-                            "f_t [Pa] > 0: a facet breaks when its normal stress s_n = F_n / (t l) "
-                            "exceeds it (tension cut-off).");
+                            "f_t [Pa] > 0: a facet breaks when its normal stress s_n = F_n / A "
+                            "exceeds it (tension cut-off; A = t l in 2D, the facet's area in 3D).");
           prm.declare_entry("Cohesion",
                             "0",
                             Patterns::Double(),
                             "c [Pa] > 0: ... or when |s_t| + tan(phi) s_n > c (Mohr-Coulomb; "
-                            "s_t = F_t / (t l), tension positive).");
+                            "s_t = F_t / A, in 3D the resultant |(V_1, V_2)| / A; tension positive).");
           prm.declare_entry("Friction angle", "0", Patterns::Double(), "phi [degrees] in [0, 90).");
           prm.declare_entry("Maximum breaks per step",
                             "1000",
@@ -178,7 +187,8 @@ namespace hysteron
 
 
 
-    Model::Model(const Scene<2> &scene, const Methods::Interface<2> &method, dealii::ParameterHandler &prm)
+    template <int dim>
+    Model<dim>::Model(const Scene<dim> &scene, const Methods::Interface<dim> &method, dealii::ParameterHandler &prm)
       : scene(scene)
       , method(method)
       , direct(std::make_unique<SparseLU>())
@@ -186,7 +196,7 @@ namespace hysteron
       scene.refuse_fem_only_sets("rbsn", true);
       {
         Section s(prm, {"RBSN"});
-        // A number is a constant d_m; anything else an expression in x and y,
+        // A number is a constant d_m; anything else an expression in x, y (and z),
         // sampled over the bodies in build_network().
         const std::string distance = dealii::Utilities::trim(s.get("Minimum distance"));
         char             *end      = nullptr;
@@ -194,23 +204,23 @@ namespace hysteron
         if (!distance.empty() && end == distance.c_str() + distance.size())
           {
             d_m     = s.get_positive("Minimum distance");
-            spacing = Spacing<2>(d_m);
+            spacing = Spacing<dim>(d_m);
           }
         else
           {
-            const std::shared_ptr<const dealii::FunctionParser<2>> d =
-              parse_function<2>(distance, "x,y", false, s.where("Minimum distance"));
-            spacing = Spacing<2>([d](const dealii::Point<2> &p) { return d->value(p); },
-                              distance,
-                              s.where("Minimum distance"));
+            const std::shared_ptr<const dealii::FunctionParser<dim>> d =
+              parse_function<dim>(distance, dim == 2 ? "x,y" : "x,y,z", false, s.where("Minimum distance"));
+            spacing = Spacing<dim>([d](const dealii::Point<dim> &p) { return d->value(p); },
+                                   distance,
+                                   s.where("Minimum distance"));
           }
         points_on_boundary = s.get_bool("Points on the boundary");
-        extra_points       = parse_points<2>(s.get("Additional points"), s.where("Additional points"));
+        extra_points       = parse_points<dim>(s.get("Additional points"), s.where("Additional points"));
         boundary_h         = s.get_non_negative("Curved boundary resolution"); // 0: in build_network()
         shear_ratio  = s.get_non_negative("Shear stiffness ratio");
         moment_yield = s.get_positive("Moment yield factor");
         spring_law_name = s.get("Spring law");
-        spring_law      = SpringLawRegistry<2>::create(spring_law_name, s.where("Spring law"));
+        spring_law      = SpringLawRegistry<dim>::create(spring_law_name, s.where("Spring law"));
         spring_law->parse_parameters(s);
         const std::string type = s.get("Analysis");
         analysis = type == "static"            ? Analysis::linear_static :
@@ -257,13 +267,16 @@ namespace hysteron
             body_shapes.push_back(&bodies[b].shape);
             mesh_body.push_back(b);
             const auto &m = scene.material(bodies[b].material, "Body " + bodies[b].name + "/Material");
-            require(m.elasticity().stress_state != Material::StressState::three_dimensional,
-                    "Body " + bodies[b].name + "/Material",
-                    "the rbsn method is two-dimensional");
-            require(m.elasticity().stress_state != Material::StressState::axisymmetric,
-                    "Body " + bodies[b].name + "/Material",
-                    "the rbsn method has no axisymmetric form (its cells are plane rigid "
-                    "bodies): use Stress state = plane stress or plane strain");
+            if constexpr (dim == 2)
+              {
+                require(m.elasticity().stress_state != Material::StressState::three_dimensional,
+                        "Body " + bodies[b].name + "/Material",
+                        "a 2D network needs a plane material (Stress state = plane stress or plane strain)");
+                require(m.elasticity().stress_state != Material::StressState::axisymmetric,
+                        "Body " + bodies[b].name + "/Material",
+                        "the rbsn method has no axisymmetric form (its cells are plane rigid "
+                        "bodies): use Stress state = plane stress or plane strain");
+              }
             require(m.spring_behaviour().type != Material::SpringBehaviour::Type::none,
                     "Body " + bodies[b].name + "/Material",
                     "the rbsn method's springs follow the uniaxial Bouc-Wen law: the body's "
@@ -277,174 +290,138 @@ namespace hysteron
           }
       require(!body_shapes.empty(), "Body names", "the rbsn method needs a body that is not rigid");
       for (const auto &b : scene.boundary_descriptions())
-        require(b.type != BoundaryDescription<2>::Type::wall,
+        require(b.type != BoundaryDescription<dim>::Type::wall,
                 "Boundary " + b.name + "/Type",
                 "the rbsn method has no walls (use fixed, roller, velocity or displacement)");
     }
 
 
 
-    Model::~Model() = default;
+    template <int dim>
+    Model<dim>::~Model() = default;
 
 
 
+    template <int dim>
     void
-    Model::build_network()
+    Model<dim>::facet_dofs(const unsigned int e, std::vector<dof_index> &dofs) const
     {
-      const auto &bodies = scene.body_descriptions();
-      // d over the bodies: its smallest value (d_m for the messages and the default
-      // resolution of curved boundaries) and the predicted number of points,
-      // 0.68 int 1/d^2 dA, which guards the memory and announces a long set-up.
-      spacing.sample(body_shapes);
-      d_m = spacing.min;
-      if (boundary_h == 0)
-        boundary_h = 0.25 * d_m;
-      std::ostringstream range;
-      if (spacing.is_constant())
-        range << "d_m = " << d_m;
-      else
-        range << "d = " << spacing.min << " ... " << spacing.max;
-      const std::string distance = range.str();
-      require(spacing.predicted_points <= 5e6,
-              "RBSN/Minimum distance",
-              "about " + std::to_string(static_cast<long>(spacing.predicted_points)) +
-                " points predicted at this minimum distance (0.68 int 1/d^2 dA over the bodies; at most 5e6)");
-      StageReport stage(scene.console(), spacing.predicted_points > 5e4);
-      if (stage.enabled())
-        scene.console() << "rbsn: about " << StageReport::count(static_cast<std::size_t>(spacing.predicted_points))
-                        << " cells predicted (0.68 int 1/d^2 dA, " << distance << " m)" << std::endl;
-
-      // The nuclei: the user's points, points along every body's boundary, then
-      // random points (one set for all bodies; each point belongs to the body
-      // that contains it).
-      std::vector<dealii::Point<2>> fixed = extra_points;
-      for (const auto &p : extra_points)
+      const auto &f = network.facets[e];
+      for (unsigned int k = 0; k < n_dofs; ++k)
         {
-          bool inside = false;
-          for (const auto *shape : body_shapes)
-            inside = inside || shape->contains(p, 1e-9 * d_m);
-          std::ostringstream point;
-          point << p;
-          require(inside, "RBSN/Additional points", "the point (" + point.str() + ") lies in no deformable body");
-        }
-      if (points_on_boundary)
-        for (const auto *shape : body_shapes)
-          {
-            const auto p = boundary_points(*shape, spacing, boundary_h);
-            fixed.insert(fixed.end(), p.begin(), p.end());
-          }
-      // Merge points closer than 1e-6 d_m (corners shared by touching bodies), the
-      // first kept: each point is compared with the kept ones in its and the
-      // neighbouring cells of a hash grid of that size.
-      std::vector<dealii::Point<2>> points;
-      {
-        const double tolerance = 1e-6 * d_m;
-        const auto   key       = [&](const dealii::Point<2> &p, const int dx, const int dy) {
-          return std::make_pair(static_cast<long long>(std::floor(p[0] / tolerance)) + dx,
-                                static_cast<long long>(std::floor(p[1] / tolerance)) + dy);
-        };
-        std::map<std::pair<long long, long long>, std::vector<unsigned int>> kept;
-        for (const auto &p : fixed)
-          {
-            bool seen = false;
-            for (int dy = -1; dy <= 1 && !seen; ++dy)
-              for (int dx = -1; dx <= 1 && !seen; ++dx)
-                if (const auto k = kept.find(key(p, dx, dy)); k != kept.end())
-                  for (const unsigned int q : k->second)
-                    seen = seen || p.distance(points[q]) < tolerance;
-            if (!seen)
-              {
-                kept[key(p, 0, 0)].push_back(points.size());
-                points.push_back(p);
-              }
-          }
-      }
-      for (unsigned int s = 0; s < body_shapes.size(); ++s)
-        {
-          // Each body is filled in turn, keeping the distance from every point so far.
-          auto filled = poisson_disk_points(*body_shapes[s], spacing, points,
-                                            scene.random_seed() + 7919 * s, "RBSN/Minimum distance");
-          points.swap(filled);
-        }
-      require(points.size() >= 2,
-              "RBSN/Minimum distance",
-              "leaves room for " + std::to_string(points.size()) +
-                " nucleus in the bodies, and a network needs at least two cells: the minimum "
-                "distance must be well below the size of the bodies (got " + distance + " m)");
-      stage(StageReport::count(points.size()) + " nuclei");
-      network = voronoi(points, body_shapes, boundary_h, "Body names");
-      stage("Voronoi cells");
-
-      // The bodies and the rigid-body mass properties about the nuclei (eq. 3.12).
-      const unsigned int n = network.cells.size();
-      cell_body.assign(n, 0);
-      cell_mass.assign(n, 0);
-      cell_inertia.assign(n, 0);
-      cell_offset.assign(n, dealii::Tensor<1, 2>());
-      const auto lo = bodies[mesh_body[0]].shape.bounding_box().get_boundary_points();
-      scale         = lo.first.distance(lo.second);
-      for (unsigned int c = 0; c < n; ++c)
-        {
-          const auto &cell = network.cells[c];
-          for (unsigned int s = 0; s < body_shapes.size(); ++s)
-            if (body_shapes[s]->contains(cell.nucleus, 1e-9 * scale))
-              {
-                cell_body[c] = mesh_body[s];
-                break;
-              }
-          const auto  &body = bodies[cell_body[c]];
-          const double rho  = scene.material(body.material, "Body " + body.name + "/Material").density();
-          // A varying thickness is taken at the cell's centroid (midpoint rule over the cell).
-          const double t    = body.thickness_at(cell.centroid);
-          const double m    = rho * t * cell.area;
-          cell_mass[c]      = m;
-          cell_offset[c]    = cell.centroid - cell.nucleus;
-          // I_c + m r^2: the polar moment about the nucleus.
-          cell_inertia[c] = rho * t * cell.polar_moment + m * cell_offset[c].norm_square();
+          dofs[k]          = n_dofs * cell_block[f.a] + k;
+          dofs[n_dofs + k] = n_dofs * cell_block[f.b] + k;
         }
     }
 
 
 
+    template <int dim>
+    std::array<unsigned int, 2 * Model<dim>::n_dofs>
+    Model<dim>::facet_local_dofs(const unsigned int e) const
+    {
+      const auto                          &f = network.facets[e];
+      std::array<unsigned int, 2 * n_dofs> dofs;
+      for (unsigned int k = 0; k < n_dofs; ++k)
+        {
+          dofs[k]          = n_dofs * f.a + k;
+          dofs[n_dofs + k] = n_dofs * f.b + k;
+        }
+      return dofs;
+    }
+
+
+
+    template <int dim>
     void
-    Model::setup_springs()
+    Model<dim>::setup_springs()
     {
       const auto &bodies = scene.body_descriptions();
-      springs.assign(network.facets.size(), Springs());
+      springs.assign(network.facets.size(), Springs<dim>());
       for (unsigned int e = 0; e < network.facets.size(); ++e)
         {
-          const Facet<2> &f  = network.facets[e];
-          Springs     &sp = springs[e];
-          const auto  &ba = bodies[cell_body[f.a]], &bb = bodies[cell_body[f.b]];
-          const auto  &ma = scene.material(ba.material, "Body " + ba.name + "/Material");
-          const auto  &mb = scene.material(bb.material, "Body " + bb.name + "/Material");
-          // The thinner side at the facet's midpoint (two bodies may meet there).
-          const double t  = std::min(ba.thickness_at(f.midpoint), bb.thickness_at(f.midpoint));
-          const double l  = f.length;
-          // Voronoi scaling (eq. 3.9), the two half-cells in series:
-          // k_n = t l / (h_a / E'_a + h_b / E'_b), k_t likewise with G, k_phi = k_n l^2 / 12.
-          sp.k[0] = t * l / (f.h_a / ma.elasticity().p_wave_modulus() + f.h_b / mb.elasticity().p_wave_modulus());
-          sp.k[1] = shear_ratio > 0 ? shear_ratio * sp.k[0] :
-                                      t * l / (f.h_a / ma.elasticity().shear_modulus() +
-                                               f.h_b / mb.elasticity().shear_modulus());
-          sp.k[2]      = sp.k[0] * l * l / 12;
-          sp.thickness = t;
-          FacetSprings<2> facet;
-          facet.k                   = sp.k;
-          facet.thickness           = t;
-          facet.length              = l;
+          const Facet<dim> &f  = network.facets[e];
+          Springs<dim>     &sp = springs[e];
+          const auto       &ba = bodies[cell_body[f.a]], &bb = bodies[cell_body[f.b]];
+          const auto       &ma = scene.material(ba.material, "Body " + ba.name + "/Material");
+          const auto       &mb = scene.material(bb.material, "Body " + bb.name + "/Material");
+          FacetSprings<dim> facet;
           facet.moment_yield_factor = moment_yield;
-          // B (eq. 3.6, with the corrections in doc/theory.md): the displacement of P as a
-          // point of cell b minus as a point of cell a, in the facet's (n, t) axes,
-          // u_P = u_i - (y_P - y_i) theta_i, v_P = v_i + (x_P - x_i) theta_i.
-          const dealii::Tensor<1, 2> n = f.normal, tt({-n[1], n[0]});
-          const dealii::Tensor<1, 2> ra = f.midpoint - network.cells[f.a].nucleus;
-          const dealii::Tensor<1, 2> rb = f.midpoint - network.cells[f.b].nucleus;
-          const auto cross = [](const dealii::Tensor<1, 2> &r, const dealii::Tensor<1, 2> &w) {
-            return r[0] * w[1] - r[1] * w[0];
-          };
-          sp.B_n = {{-n[0], -n[1], -cross(ra, n), n[0], n[1], cross(rb, n)}};
-          sp.B_t = {{-tt[0], -tt[1], -cross(ra, tt), tt[0], tt[1], cross(rb, tt)}};
+          // B (eq. 3.6, with the corrections in doc/theory.md): the displacement of the
+          // facet's point P as a point of cell b minus as a point of cell a, u_P = u_i +
+          // theta_i x (P - x_i), in the facet's axes, and the relative rotation
+          // theta_b - theta_a in them.
+          const dealii::Tensor<1, dim> ra = f.midpoint - nuclei[cell_id[f.a]];
+          const dealii::Tensor<1, dim> rb = f.midpoint - nuclei[cell_id[f.b]];
+          if constexpr (dim == 2)
+            {
+              // The thinner side at the facet's midpoint (two bodies may meet there).
+              const double t = std::min(ba.thickness_at(f.midpoint), bb.thickness_at(f.midpoint));
+              const double l = f.length;
+              // Voronoi scaling (eq. 3.9), the two half-cells in series:
+              // k_n = t l / (h_a / E'_a + h_b / E'_b), k_t likewise with G, k_phi = k_n l^2 / 12.
+              sp.k[0] = t * l / (f.h_a / ma.elasticity().p_wave_modulus() + f.h_b / mb.elasticity().p_wave_modulus());
+              sp.k[1] = shear_ratio > 0 ? shear_ratio * sp.k[0] :
+                                          t * l / (f.h_a / ma.elasticity().shear_modulus() +
+                                                   f.h_b / mb.elasticity().shear_modulus());
+              sp.k[2]                  = sp.k[0] * l * l / 12;
+              sp.thickness             = t;
+              sp.area                  = t * l;
+              facet.thickness          = t;
+              facet.length             = l;
+              facet.area               = t * l;
+              facet.second_moments[0]  = t * l * l * l / 12;
+              // u_P = u_i - (y_P - y_i) theta_i, v_P = v_i + (x_P - x_i) theta_i.
+              const dealii::Tensor<1, 2> n = f.normal, tt({-n[1], n[0]});
+              const auto cross = [](const dealii::Tensor<1, 2> &r, const dealii::Tensor<1, 2> &w) {
+                return r[0] * w[1] - r[1] * w[0];
+              };
+              sp.B[0] = {{-n[0], -n[1], -cross(ra, n), n[0], n[1], cross(rb, n)}};
+              sp.B[1] = {{-tt[0], -tt[1], -cross(ra, tt), tt[0], tt[1], cross(rb, tt)}};
+              sp.B[2] = {{0, 0, -1, 0, 0, 1}};
+            }
+          else
+            {
+              // k_n = A / (h_a / E'_a + h_b / E'_b), the shear springs likewise with G, the
+              // bending springs k_n I_i / A (E I_i / h of the beam between the nuclei), the
+              // torsion spring k_s J / A (G J / h), J = I_1 + I_2 (doc/rbsn3d.md).
+              const double A = f.area, I1 = f.second_moment_1, I2 = f.second_moment_2;
+              const double kn = A / (f.h_a / ma.elasticity().p_wave_modulus() + f.h_b / mb.elasticity().p_wave_modulus());
+              const double ks = shear_ratio > 0 ? shear_ratio * kn :
+                                                  A / (f.h_a / ma.elasticity().shear_modulus() +
+                                                       f.h_b / mb.elasticity().shear_modulus());
+              sp.k = {{kn, ks, ks, kn * I1 / A, kn * I2 / A, ks * (I1 + I2) / A}};
+              sp.area                 = A;
+              facet.area              = A;
+              facet.length            = std::sqrt(A);
+              facet.second_moments[0] = I1;
+              facet.second_moments[1] = I2;
+              // Rows of the translations along t: t . (u_b + theta_b x r_b - u_a - theta_a x r_a)
+              // = t . u_b + theta_b . (r_b x t) - t . u_a - theta_a . (r_a x t); rotations
+              // about t: t . (theta_b - theta_a).
+              const std::array<dealii::Tensor<1, 3>, 3> axes{{f.normal, f.axis_1, f.axis_2}};
+              for (unsigned int i = 0; i < 3; ++i)
+                {
+                  const dealii::Tensor<1, 3> &t  = axes[i];
+                  const dealii::Tensor<1, 3>  ca = dealii::cross_product_3d(ra, t), cb = dealii::cross_product_3d(rb, t);
+                  for (unsigned int d = 0; d < 3; ++d)
+                    {
+                      sp.B[i][d]     = -t[d];
+                      sp.B[i][3 + d] = -ca[d];
+                      sp.B[i][6 + d] = t[d];
+                      sp.B[i][9 + d] = cb[d];
+                    }
+                }
+              // The rotations in the order of the springs: about axis_1, axis_2, the normal.
+              const std::array<dealii::Tensor<1, 3>, 3> rotation_axes{{f.axis_1, f.axis_2, f.normal}};
+              for (unsigned int i = 0; i < 3; ++i)
+                for (unsigned int d = 0; d < 3; ++d)
+                  {
+                    sp.B[3 + i][3 + d] = -rotation_axes[i][d];
+                    sp.B[3 + i][9 + d] = rotation_axes[i][d];
+                  }
+            }
+          facet.k = sp.k;
 
           // The spring law's springs (static: linear springs, the plasticity ignored).
           if (analysis != Analysis::linear_static)
@@ -454,7 +431,7 @@ namespace hysteron
               if (!sp.hysteretic)
                 sp.state.clear();
             }
-          for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int i = 0; i < n_dofs; ++i)
             sp.tangent[i][i] = sp.k[i]; // the first predictor's
           sp.trial_state = sp.state;
         }
@@ -462,77 +439,101 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Model::setup_system()
+    Model<dim>::setup_system()
     {
-      const unsigned int n = 3 * network.cells.size();
-      partition();
-      // The serial matrix: one rank, or rank 0 under the gathered UMFPACK solver.
-      if (!trilinos_system() ||
-          (distributed() && linear_solver == "direct" && distributed_solver == "UMFPACK" && rank == 0))
+      setup_parallel_system();
+      // The serial matrix: one part, or rank 0 under the gathered UMFPACK solver.
+      const bool gathered = distributed() && linear_solver == "direct" && distributed_solver == "UMFPACK";
+      if (!trilinos_system() || (gathered && scene.is_root()))
         {
+          const dof_index                n = n_dofs * nuclei.size();
           dealii::DynamicSparsityPattern dsp(n, n);
-          for (unsigned int c = 0; c < network.cells.size(); ++c)
-            for (unsigned int i = 0; i < 3; ++i)
-              for (unsigned int j = 0; j < 3; ++j)
-                dsp.add(3 * c + i, 3 * c + j);
-          for (const auto &f : network.facets)
-            for (const unsigned int p : {f.a, f.b})
-              for (const unsigned int q : {f.a, f.b})
-                for (unsigned int i = 0; i < 3; ++i)
-                  for (unsigned int j = 0; j < 3; ++j)
-                    dsp.add(3 * p + i, 3 * q + j);
+          const auto block = [&](const dof_index p, const dof_index q) {
+            for (unsigned int i = 0; i < n_dofs; ++i)
+              for (unsigned int j = 0; j < n_dofs; ++j)
+                dsp.add(n_dofs * p + i, n_dofs * q + j);
+          };
+          if (!distributed())
+            {
+              for (unsigned int c = 0; c < cell_id.size(); ++c)
+                block(c, c);
+              for (const auto &f : network.facets)
+                for (const unsigned int p : {f.a, f.b})
+                  for (const unsigned int q : {f.a, f.b})
+                    block(p, q);
+            }
+          else
+            {
+              // Rank 0 holds the whole pattern: the cells' blocks and every rank's facets'
+              // pairs of blocks (gathered once).
+              for (dof_index c = 0; c < nuclei.size(); ++c)
+                block(c, c);
+              std::vector<unsigned long long> pairs;
+              for (const auto &f : network.facets)
+                pairs.insert(pairs.end(), {cell_block[f.a], cell_block[f.b]});
+              const auto all = Collective::gather(pairs, scene.mpi_communicator(), 0);
+              for (std::size_t k = 0; k < all.size(); k += 2)
+                for (const auto p : {all[k], all[k + 1]})
+                  for (const auto q : {all[k], all[k + 1]})
+                    block(p, q);
+            }
           pattern.copy_from(dsp);
           matrix.reinit(pattern);
           factored_matrix.reinit(pattern);
         }
+      else if (gathered)
+        {
+          std::vector<unsigned long long> pairs;
+          for (const auto &f : network.facets)
+            pairs.insert(pairs.end(), {cell_block[f.a], cell_block[f.b]});
+          Collective::gather(pairs, scene.mpi_communicator(), 0);
+        }
       factorized = false;
       direct->clear();
-      for (Vector *w : {&u, &u_trial, &v, &a, &rhs, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
-        w->reinit(n);
     }
 
 
 
+    template <int dim>
     void
-    Model::setup_conditions()
+    Model<dim>::setup_conditions()
     {
-      using Type         = BoundaryDescription<2>::Type;
+      using Type         = typename BoundaryDescription<dim>::Type;
       const auto &bodies = scene.body_descriptions();
-      const auto  box    = [&] {
-        dealii::Point<2> lo(1e300, 1e300), hi(-1e300, -1e300);
-        for (const auto &c : network.cells)
-          for (unsigned int d = 0; d < 2; ++d)
-            {
-              lo[d] = std::min(lo[d], c.nucleus[d]);
-              hi[d] = std::max(hi[d], c.nucleus[d]);
-            }
-        return std::make_pair(lo, hi);
-      }();
+      const auto &lo = nuclei_box[0], &hi = nuclei_box[1];
       const double tolerance = 1e-9 * scale;
+      const MPI_Comm comm    = network_communicator();
+      const unsigned int n_local = cell_id.size();
+      const auto nucleus = [&](const unsigned int c) -> const dealii::Point<dim> & { return nuclei[cell_id[c]]; };
+      const auto count   = [&](const std::size_t n) { return dealii::Utilities::MPI::sum<unsigned long>(n, comm); };
       // History sets: the cells whose nucleus lies on the set's faces of the nuclei's box
       // or in its region (the rule of the boundary conditions).
       history_cells.clear();
+      history_size.clear();
       for (const unsigned int k : scene.output_control().history_sets)
         {
-          const SetDescription<2>  &d = scene.set_descriptions()[k];
-          std::vector<unsigned int> cells;
-          for (unsigned int c = 0; c < network.cells.size(); ++c)
+          const SetDescription<dim> &d = scene.set_descriptions()[k];
+          std::vector<unsigned int>  cells;
+          for (unsigned int c = 0; c < n_owned_cells; ++c)
             {
-              const auto &x  = network.cells[c].nucleus;
+              const auto &x  = nucleus(c);
               bool        in = d.has_region && d.region.contains(x, tolerance);
               for (const unsigned int face : d.faces)
-                in = in || std::abs(x[face / 2] - (face % 2 == 0 ? box.first[face / 2] : box.second[face / 2])) <= tolerance;
+                in = in || std::abs(x[face / 2] - (face % 2 == 0 ? lo[face / 2] : hi[face / 2])) <= tolerance;
               if (in)
                 cells.push_back(c);
             }
-          require(!cells.empty(),
+          const unsigned long n = count(cells.size());
+          require(n > 0,
                   d.where(),
                   "selects no cell of the network (a cell is selected by its nucleus: on the face "
                   "of the nuclei's bounding box, or in the region)");
           history_cells.push_back(std::move(cells));
+          history_size.push_back(n);
         }
-      dof_set.assign(3 * network.cells.size(), -1);
+      dof_set.assign(n_dofs * n_local, -1);
       dirichlet.clear();
       const auto take = [&](Dirichlet &set, const unsigned int dof) {
         if (dof_set[dof] < 0)
@@ -541,28 +542,31 @@ namespace hysteron
             set.dofs.push_back(dof);
           }
       };
-      // u and v by the boundary's rule; the rotation with both (fixed, or velocity /
-      // displacement of x and y: the rigid motion the field gives the nucleus), not
-      // for a roller.
+      // The translations by the boundary's rule; the rotations with all of them (fixed,
+      // or velocity / displacement of every component: the rigid motion the field gives
+      // the nucleus), not for a roller. Every local cell, ghosts included.
       for (unsigned int b = 0; b < scene.boundary_descriptions().size(); ++b)
         {
           const auto &d = scene.boundary_descriptions()[b];
           Dirichlet   set;
           set.name     = d.name;
           set.boundary = b;
-          for (unsigned int c = 0; c < network.cells.size(); ++c)
+          for (unsigned int c = 0; c < n_local; ++c)
             {
-              const auto &x = network.cells[c].nucleus;
-              bool        both = d.type != Type::roller;
-              for (unsigned int k = 0; k < 2; ++k)
-                if (d.prescribes(x, k, box.first, box.second, tolerance))
-                  take(set, 3 * c + k);
+              const auto &x   = nucleus(c);
+              bool        all = d.type != Type::roller;
+              for (unsigned int k = 0; k < dim; ++k)
+                if (d.prescribes(x, k, lo, hi, tolerance))
+                  take(set, n_dofs * c + k);
                 else
-                  both = false;
-              if (both)
-                take(set, 3 * c + 2);
+                  all = false;
+              if (all)
+                for (unsigned int k = dim; k < n_dofs; ++k)
+                  take(set, n_dofs * c + k);
             }
-          require(!set.dofs.empty(),
+          const bool owns = std::any_of(set.dofs.begin(), set.dofs.end(),
+                                        [&](const unsigned int i) { return i < n_dofs * n_owned_cells; });
+          require(count(owns ? 1 : 0) > 0,
                   "Boundary " + d.name + (!d.set.empty() ? "/Set" : d.has_region ? "/Region" : "/Faces"),
                   "selects no cell of the network (a cell is selected by its nucleus: on the face "
                   "of the nuclei's bounding box, or in the region)");
@@ -574,11 +578,13 @@ namespace hysteron
             Dirichlet set;
             set.name  = bodies[b].name;
             set.rigid = b;
-            for (unsigned int c = 0; c < network.cells.size(); ++c)
-              if (bodies[b].shape.contains(network.cells[c].nucleus, tolerance))
-                for (unsigned int k = 0; k < 3; ++k)
-                  take(set, 3 * c + k);
-            require(!set.dofs.empty(),
+            for (unsigned int c = 0; c < n_local; ++c)
+              if (bodies[b].shape.contains(nucleus(c), tolerance))
+                for (unsigned int k = 0; k < n_dofs; ++k)
+                  take(set, n_dofs * c + k);
+            const bool owns = std::any_of(set.dofs.begin(), set.dofs.end(),
+                                          [&](const unsigned int i) { return i < n_dofs * n_owned_cells; });
+            require(count(owns ? 1 : 0) > 0,
                     "Body " + bodies[b].name + "/Shape",
                     "the rigid body holds no nucleus of the network (it moves the cells whose "
                     "nuclei lie in its shape)");
@@ -593,31 +599,53 @@ namespace hysteron
         {
           LoadSet set;
           set.load = l;
-          if (loads[l].type == LoadDescription<2>::Type::force)
+          if (loads[l].type == LoadDescription<dim>::Type::force)
             {
-              for (unsigned int c = 0; c < network.cells.size(); ++c)
-                if (loads[l].region.contains(network.cells[c].nucleus, tolerance))
+              for (unsigned int c = 0; c < n_owned_cells; ++c)
+                if (loads[l].region.contains(nucleus(c), tolerance))
                   {
                     set.cells.push_back(c);
                     set.arm.emplace_back();
                   }
+              const unsigned long n = count(set.cells.size());
               for (unsigned int k = 0; k < set.cells.size(); ++k)
-                set.weight.push_back(1.0 / set.cells.size());
+                set.weight.push_back(1.0 / n);
             }
           else
-            for (unsigned int c = 0; c < network.cells.size(); ++c)
+            for (unsigned int c = 0; c < n_owned_cells; ++c)
               for (const auto &piece : network.cells[c].boundary)
                 {
-                  const dealii::Point<2> mid = 0.5 * (piece[0] + piece[1]);
+                  // The piece's centroid and area (a segment times the thickness in 2D).
+                  dealii::Point<dim> mid;
+                  double             weight = 0;
+                  if constexpr (dim == 2)
+                    {
+                      mid    = 0.5 * (piece[0] + piece[1]);
+                      weight = piece[0].distance(piece[1]) * bodies[cell_body[c]].thickness_at(mid);
+                    }
+                  else
+                    {
+                      // A planar polygon: fan triangles from its first vertex.
+                      dealii::Tensor<1, 3> moment;
+                      for (unsigned int k = 1; k + 1 < piece.size(); ++k)
+                        {
+                          const double a = 0.5 * dealii::cross_product_3d(piece[k] - piece[0], piece[k + 1] - piece[0]).norm();
+                          weight += a;
+                          moment += a / 3 * (piece[0] + piece[k] + piece[k + 1]);
+                        }
+                      if (weight <= 0)
+                        continue;
+                      mid = dealii::Point<3>(moment / weight);
+                    }
                   if (!loads[l].region.contains(mid, tolerance))
                     continue;
                   set.cells.push_back(c);
-                  set.arm.push_back(mid - network.cells[c].nucleus);
-                  set.weight.push_back(piece[0].distance(piece[1]) * bodies[cell_body[c]].thickness_at(mid));
+                  set.arm.push_back(mid - nucleus(c));
+                  set.weight.push_back(weight);
                 }
-          require(!set.cells.empty(),
+          require(count(set.cells.size()) > 0,
                   "Load " + loads[l].name + "/Region",
-                  loads[l].type == LoadDescription<2>::Type::force ?
+                  loads[l].type == LoadDescription<dim>::Type::force ?
                     "contains no nucleus of the network" :
                     "contains no boundary piece of the network");
           load_sets.push_back(std::move(set));
@@ -626,65 +654,79 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Model::make_constraints(const double t0, const double t1, const bool predictor)
+    Model<dim>::make_constraints(const double t0, const double t1, const bool predictor)
     {
       constraints.clear();
+      constraints.reinit(relevant_dofs);
       for (unsigned int s = 0; s < dirichlet.size(); ++s)
         {
           const auto &set = dirichlet[s];
           for (const unsigned int dof : set.dofs)
             {
-              constraints.add_line(dof);
+              constraints.add_line(global_dof(dof));
               if (predictor)
-                constraints.set_inhomogeneity(dof, prescribed_increment(set, dof, t0, t1));
+                constraints.set_inhomogeneity(global_dof(dof), prescribed_increment(set, dof, t0, t1));
             }
         }
       // Released cells (a fragment nothing holds) keep their displacements.
       if (n_released > 0)
         for (unsigned int c = 0; c < released.size(); ++c)
           if (released[c])
-            for (unsigned int k = 0; k < 3; ++k)
-              if (!constraints.is_constrained(3 * c + k))
-                constraints.add_line(3 * c + k);
+            for (unsigned int k = 0; k < n_dofs; ++k)
+              if (!constraints.is_constrained(global_dof(n_dofs * c + k)))
+                constraints.add_line(global_dof(n_dofs * c + k));
       constraints.close();
     }
 
 
 
+    template <int dim>
     double
-    Model::prescribed_increment(const Dirichlet &set, const unsigned int dof, const double t0, const double t1) const
+    Model<dim>::prescribed_increment(const Dirichlet &set, const unsigned int dof, const double t0, const double t1) const
     {
-      const unsigned int c = dof / 3, k = dof % 3;
+      const unsigned int c = dof / n_dofs, k = dof % n_dofs;
       if (set.rigid >= 0)
-        return k < 2 ? scene.body_descriptions()[set.rigid].rigid_displacement(t0, t1)[k] : 0.0;
+        return k < dim ? scene.body_descriptions()[set.rigid].rigid_displacement(t0, t1)[k] : 0.0;
       const auto &d = scene.boundary_descriptions()[set.boundary];
-      const auto &x = network.cells[c].nucleus;
-      if (k < 2 && (d.velocity || d.displacement))
+      const auto &x = nuclei[cell_id[c]];
+      if (k < dim && (d.velocity || d.displacement))
         return d.displacement_increment(t0, t1, x)[k];
-      if (k == 2 && d.displacement)
+      if (k >= dim && d.displacement)
         {
-          // The rotation 1/2 (du_y/dx - du_x/dy) of the field, by central differences.
+          // The rotation 1/2 curl u of the field, by central differences: in 2D
+          // 1/2 (du_y/dx - du_x/dy); in 3D component i is 1/2 (du_k/dx_j - du_j/dx_k) for
+          // (i, j, k) cyclic.
           const double e  = 1e-4 * scale;
-          const auto   du = [&](const double dx, const double dy) {
-            return d.displacement_increment(t0, t1, x + dealii::Tensor<1, 2>({dx, dy}));
+          const auto   du = [&](const unsigned int direction, const double h) {
+            dealii::Tensor<1, dim> shift;
+            shift[direction] = h;
+            return d.displacement_increment(t0, t1, x + shift);
           };
-          return 0.25 / e * ((du(e, 0)[1] - du(-e, 0)[1]) - (du(0, e)[0] - du(0, -e)[0]));
+          if constexpr (dim == 2)
+            return 0.25 / e * ((du(0, e)[1] - du(0, -e)[1]) - (du(1, e)[0] - du(1, -e)[0]));
+          else
+            {
+              const unsigned int i = k - dim, j = (i + 1) % 3, l = (i + 2) % 3;
+              return 0.25 / e * ((du(j, e)[l] - du(j, -e)[l]) - (du(l, e)[j] - du(l, -e)[j]));
+            }
         }
       return 0;
     }
 
 
 
+    template <int dim>
     double
-    Model::prescribed_velocity(const Dirichlet &set, const unsigned int dof, const double t) const
+    Model<dim>::prescribed_velocity(const Dirichlet &set, const unsigned int dof, const double t) const
     {
-      const unsigned int k = dof % 3;
+      const unsigned int k = dof % n_dofs;
       if (set.rigid >= 0)
-        return k < 2 ? scene.body_descriptions()[set.rigid].rigid_velocity_at(t)[k] : 0.0;
+        return k < dim ? scene.body_descriptions()[set.rigid].rigid_velocity_at(t)[k] : 0.0;
       const auto &d = scene.boundary_descriptions()[set.boundary];
       if (d.velocity)
-        return k < 2 ? d.velocity_at(t)[k] : 0.0;
+        return k < dim ? d.velocity_at(t)[k] : 0.0;
       if (!d.displacement)
         return 0; // fixed, roller
       // g'(t) = (g(t + h) - g(t - h)) / 2h, error O(h^2).
@@ -694,56 +736,77 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Model::cell_mass_matrix(const unsigned int c, dealii::FullMatrix<double> &M) const
+    Model<dim>::cell_mass_matrix(const unsigned int c, dealii::FullMatrix<double> &M) const
     {
-      // Rigid cell of mass m, centroid at o from the nucleus, polar moment I about the
-      // nucleus: the kinetic energy 1/2 m |v + omega x o|^2 + 1/2 I_c omega^2 (eq. 3.12).
-      const double m = cell_mass[c], ox = cell_offset[c][0], oy = cell_offset[c][1];
-      M.reinit(3, 3);
-      M(0, 0) = M(1, 1) = m;
-      M(0, 2) = M(2, 0) = -m * oy;
-      M(1, 2) = M(2, 1) = m * ox;
-      M(2, 2)           = cell_inertia[c];
+      // Rigid cell of mass m, centroid at o from the nucleus, inertia J about the nucleus:
+      // the kinetic energy 1/2 m |u' + omega x o|^2 + 1/2 omega . J_c omega (eq. 3.12), i.e.
+      // M = [m I, -m [o]x; m [o]x, J] with [o]x w = o x w (in 2D omega = theta' e_z).
+      const double                  m = cell_mass[c];
+      const dealii::Tensor<1, dim> &o = cell_offset[c];
+      M.reinit(n_dofs, n_dofs);
+      for (unsigned int d = 0; d < dim; ++d)
+        M(d, d) = m;
+      if constexpr (dim == 2)
+        {
+          M(0, 2) = M(2, 0) = -m * o[1];
+          M(1, 2) = M(2, 1) = m * o[0];
+          M(2, 2)           = cell_inertia[c][0][0];
+        }
+      else
+        {
+          // -m [o]x = m [[0, o_z, -o_y], [-o_z, 0, o_x], [o_y, -o_x, 0]] (rows u, columns theta).
+          const double C[3][3] = {{0, m * o[2], -m * o[1]}, {-m * o[2], 0, m * o[0]}, {m * o[1], -m * o[0], 0}};
+          for (unsigned int i = 0; i < 3; ++i)
+            for (unsigned int j = 0; j < 3; ++j)
+              {
+                M(i, 3 + j) = C[i][j];
+                M(3 + j, i) = C[i][j];
+                M(3 + i, 3 + j) = cell_inertia[c][i][j];
+              }
+        }
     }
 
 
 
+    template <int dim>
     void
-    Model::external_forces(const double t, Vector &f) const
+    Model<dim>::external_forces(const double t, Vector &f) const
     {
-      // Loads, and gravity at the centroids (a force and its moment about the nucleus).
-      f                      = 0;
-      const auto          &loads = scene.load_descriptions();
-      const auto           cross = [](const dealii::Tensor<1, 2> &r, const dealii::Tensor<1, 2> &w) {
-        return r[0] * w[1] - r[1] * w[0];
+      // Loads, and gravity at the centroids (a force and its moment about the nucleus),
+      // on the owned cells.
+      f                 = 0;
+      const auto &loads = scene.load_descriptions();
+      const auto  add   = [&](const unsigned int c, const dealii::Tensor<1, dim> &arm, const dealii::Tensor<1, dim> &F) {
+        for (unsigned int d = 0; d < dim; ++d)
+          f.local_element(n_dofs * c + d) += F[d];
+        if constexpr (dim == 2)
+          f.local_element(n_dofs * c + 2) += arm[0] * F[1] - arm[1] * F[0];
+        else
+          {
+            const dealii::Tensor<1, 3> m = dealii::cross_product_3d(arm, F);
+            for (unsigned int d = 0; d < 3; ++d)
+              f.local_element(n_dofs * c + 3 + d) += m[d];
+          }
       };
       for (const auto &set : load_sets)
         {
-          const dealii::Tensor<1, 2> value = loads[set.load].value_at(t);
+          const dealii::Tensor<1, dim> value = loads[set.load].value_at(t);
           for (unsigned int k = 0; k < set.cells.size(); ++k)
-            {
-              const dealii::Tensor<1, 2> F = set.weight[k] * value;
-              f(3 * set.cells[k]) += F[0];
-              f(3 * set.cells[k] + 1) += F[1];
-              f(3 * set.cells[k] + 2) += cross(set.arm[k], F);
-            }
+            add(set.cells[k], set.arm[k], set.weight[k] * value);
         }
-      const dealii::Tensor<1, 2> &g = scene.gravity();
+      const dealii::Tensor<1, dim> &g = scene.gravity();
       if (g.norm() > 0)
-        for (unsigned int c = 0; c < network.cells.size(); ++c)
-          {
-            const dealii::Tensor<1, 2> F = cell_mass[c] * g;
-            f(3 * c) += F[0];
-            f(3 * c + 1) += F[1];
-            f(3 * c + 2) += cross(cell_offset[c], F);
-          }
+        for (unsigned int c = 0; c < n_owned_cells; ++c)
+          add(c, cell_offset[c], cell_mass[c] * g);
     }
 
 
 
+    template <int dim>
     bool
-    Model::renew_factors()
+    Model<dim>::renew_factors()
     {
       // Refactorize only on change: an unchanged tangent (elastic steps, static analyses)
       // keeps its factors; with a reuse tolerance, a tangent within it of the factorized
@@ -772,7 +835,7 @@ namespace hysteron
                   for (int k = 0; k < std::min(n_a, n_f); ++k)
                     add(a[k], f[k]);
                 }
-              const int ierr = MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, scene.mpi_communicator());
+              const int ierr = MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, network_communicator());
               AssertThrowMPI(ierr);
             }
           else
@@ -790,8 +853,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     RuntimeError
-    Model::singular_tangent()
+    Model<dim>::singular_tangent()
     {
       return RuntimeError("rbsn: the tangent stiffness matrix is singular: the network is a "
                           "mechanism (springs without stiffness, e.g. perfectly plastic ones at "
@@ -800,8 +864,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Model::solve_linear(Vector &x)
+    Model<dim>::solve_linear(Vector &x)
     {
       if (trilinos_system())
         return solve_distributed(x);
@@ -814,7 +879,10 @@ namespace hysteron
               factorized = true;
               ++n_factorizations;
             }
-          direct->solve(x, rhs);
+          // One part: the local entries are the global ones.
+          dealii::Vector<double> b(rhs.begin(), rhs.begin() + rhs.locally_owned_size()), y(b.size());
+          direct->solve(y, b);
+          std::copy(y.begin(), y.end(), x.begin());
         }
       catch (const std::runtime_error &)
         {
@@ -824,25 +892,29 @@ namespace hysteron
 
 
 
+    template <int dim>
     std::string
-    Model::summary(const unsigned long steps, const unsigned int outputs) const
+    Model<dim>::summary(const unsigned long steps, const unsigned int outputs) const
     {
       std::ostringstream s;
-      s << network.cells.size() << " cells, " << network.facets.size() << " facets, "
+      s << nuclei.size() << " cells, " << n_global_facets << " facets, "
         << (analysis == Analysis::variable_order ? n_steps : steps) << " steps, " << n_newton
         << " Newton iterations";
       s << ", " << n_factorizations << " factorizations";
       if (incremental_assembly && n_facet_evaluations > 0)
         {
-          std::ostringstream share;
-          share << std::fixed << std::setprecision(1) << 100.0 * n_facet_updates / n_facet_evaluations;
+          const MPI_Comm      comm    = network_communicator();
+          const unsigned long updates = dealii::Utilities::MPI::sum(n_facet_updates, comm);
+          const unsigned long total   = dealii::Utilities::MPI::sum(n_facet_evaluations, comm);
+          std::ostringstream  share;
+          share << std::fixed << std::setprecision(1) << 100.0 * updates / total;
           s << " (" << n_matrix_assemblies - n_full_assemblies << " of " << n_matrix_assemblies
             << " tangents updated in place, " << share.str() << " % of the facets' matrices)";
         }
       if (linear_solver != "direct")
         s << " (" << linear_solver << " + AMG, " << n_linear_iterations << " iterations)";
       else if (distributed())
-        s << " (" << distributed_solver << " on " << n_ranks << " MPI ranks)";
+        s << " (" << distributed_solver << " on " << n_parts << " MPI ranks)";
       if (n_exact_retries > 0)
         s << " (" << n_exact_retries << " steps again with exact Newton)";
       if (fracture.enabled)
@@ -859,6 +931,11 @@ namespace hysteron
 
 
 
+    template class Model<2>;
+    template class Model<3>;
+
+
+
     template <int dim>
     Solver<dim>::Solver() = default;
 
@@ -869,7 +946,7 @@ namespace hysteron
     void
     Solver<dim>::declare_parameters(dealii::ParameterHandler &prm)
     {
-      Model::declare_parameters(prm);
+      Model<dim>::declare_parameters(prm);
     }
 
     template <int dim>
@@ -881,17 +958,10 @@ namespace hysteron
               "Output/Additional columns",
               "the rbsn method's probe tables hold cell and facet values; additional point "
               "columns apply to the mpm and fem methods");
-      if constexpr (dim == 2)
-        model = std::make_unique<Model>(this->get_scene(), *this, prm);
-      else
-        {
-          (void)prm;
-          throw InputError("Dimension", "the rbsn method is two-dimensional (set Dimension = 2)");
-        }
+      model = std::make_unique<Model<dim>>(this->get_scene(), *this, prm);
     }
 
-    // The driver's hooks: the network is two-dimensional, so only Solver<2> has a
-    // model (a 3D scene is refused when the parameters are read).
+    // The driver's hooks.
     template <int dim>
     void
     Solver<dim>::setup()
@@ -903,7 +973,8 @@ namespace hysteron
     double
     Solver<dim>::size_of_state() const
     {
-      return model ? 3.0 * model->tessellation().cells.size() : 0.0; // u, v, theta per cell
+      // u and theta per cell.
+      return model ? double(Model<dim>::n_dofs) * model->n_global_cells() : 0.0;
     }
 
     template <int dim>
@@ -992,4 +1063,4 @@ HYSTERON_REGISTER_METHOD(hysteron::RBSN::Solver,
                          "rbsn",
                          "the Rigid-Body-Spring Network: Voronoi cells as rigid bodies joined by "
                          "Bouc-Wen springs at their facets, static, quasi-static and dynamic, with "
-                         "brittle fracture; 2D; see doc/rbsn.md");
+                         "brittle fracture; 2D and 3D; see doc/rbsn.md");

@@ -1,18 +1,17 @@
-// The RBSN under MPI. The network (cells, facets, their geometry) and the DoF
-// vectors are replicated: every rank builds the same network from the same seed.
-// The work is shared: the cells are partitioned over the ranks by METIS on the
-// cell graph (a facet belongs to the owner of its first cell), each rank
-// evaluates the spring laws of its facets and assembles them into a distributed
-// Trilinos matrix, which is factorized by UMFPACK on rank 0 (gathered) or by
-// Trilinos Amesos (KLU on one rank, or MUMPS in parallel). After every converged step
-// the facets' states go from their owners to every rank, so that outputs,
-// fracture, fragments and checkpoints see the whole network on every rank.
+// The RBSN under MPI. The network is distributed (network.cc): each rank has its own
+// cells (a part of a coordinate bisection of the nuclei), the facets whose first cell
+// is its own, and the neighbouring cells of other ranks as ghosts. The DoF vectors are
+// distributed vectors over the owned and ghost cells' DoFs; each rank evaluates the
+// spring laws of its facets and assembles them into a distributed Trilinos matrix (the
+// rows of ghost cells travel to their owners), which is factorized by UMFPACK on rank 0
+// (gathered), by Trilinos Amesos (KLU on one rank, or MUMPS in parallel), or solved by
+// CG / GMRES with algebraic multigrid.
 #include <deal.II/base/mpi.h>
+#include <deal.II/lac/affine_constraints.templates.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
 #include <deal.II/lac/solver_gmres.h>
-#include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/sparsity_tools.h>
 #include <deal.II/lac/trilinos_index_access.h>
 #include <deal.II/lac/trilinos_precondition.h>
@@ -34,155 +33,69 @@ namespace hysteron
 {
   namespace RBSN
   {
-    void
-    Model::partition()
+    template <int dim>
+    MPI_Comm
+    Model<dim>::network_communicator() const
     {
-      const MPI_Comm     comm    = scene.mpi_communicator();
-      const unsigned int n_cells = network.cells.size();
-      // Variable order integrates one serial vector (SUNDIALS IDA): every rank runs the
-      // whole network, as does a network with fewer cells than ranks.
-      const bool replicated = analysis == Analysis::variable_order ||
-                              n_cells < dealii::Utilities::MPI::n_mpi_processes(comm);
-      n_ranks = replicated ? 1 : dealii::Utilities::MPI::n_mpi_processes(comm);
-      rank    = replicated ? 0 : dealii::Utilities::MPI::this_mpi_process(comm);
-      cell_owner.assign(n_cells, 0);
-      if (n_ranks > 1)
-        {
-          // METIS on the graph of the cells joined by facets: balanced parts with
-          // few facets across the cut. The same input gives the same parts on every rank.
-          dealii::DynamicSparsityPattern graph(n_cells, n_cells);
-          for (const auto &f : network.facets)
-            {
-              graph.add(f.a, f.b);
-              graph.add(f.b, f.a);
-            }
-          dealii::SparsityPattern pattern;
-          pattern.copy_from(graph);
-          dealii::SparsityTools::partition(pattern, n_ranks, cell_owner, dealii::SparsityTools::Partitioner::metis);
-        }
-      owned_facet.assign(network.facets.size(), false);
-      owned_facets.clear();
-      for (unsigned int e = 0; e < network.facets.size(); ++e)
-        if (cell_owner[network.facets[e].a] == rank)
-          {
-            owned_facet[e] = true;
-            owned_facets.push_back(e);
-          }
-      owned_dofs.set_size(3 * n_cells);
-      for (unsigned int c = 0; c < n_cells; ++c)
-        if (cell_owner[c] == rank)
-          owned_dofs.add_range(3 * c, 3 * c + 3);
+      return distributed() ? scene.mpi_communicator() : MPI_COMM_SELF;
+    }
+
+
+
+    template <int dim>
+    void
+    Model<dim>::setup_parallel_system()
+    {
+      const MPI_Comm  comm = network_communicator();
+      const dof_index n    = n_dofs * nuclei.size();
+      // The owned DoFs are one range (the cells' blocks are numbered rank by rank); the
+      // relevant ones add the ghost cells'.
+      owned_dofs.clear();
+      owned_dofs.set_size(n);
+      if (n_owned_cells > 0)
+        owned_dofs.add_range(n_dofs * cell_block[0], n_dofs * (cell_block[0] + n_owned_cells));
       owned_dofs.compress();
+      relevant_dofs = owned_dofs;
+      for (unsigned int c = n_owned_cells; c < cell_id.size(); ++c)
+        relevant_dofs.add_range(n_dofs * cell_block[c], n_dofs * cell_block[c] + n_dofs);
+      relevant_dofs.compress();
+      partitioner = std::make_shared<dealii::Utilities::MPI::Partitioner>(owned_dofs, relevant_dofs, comm);
+      for (Vector *w : {&u, &u_trial, &v, &a, &rhs, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
+        w->reinit(partitioner);
       if (!trilinos_system())
         return;
 
       // The matrix: the cell blocks of the owned cells and the couplings of the owned
       // facets (rows of other ranks' cells go to their owners).
-      dealii::IndexSet relevant = owned_dofs;
-      dealii::DynamicSparsityPattern dsp(3 * n_cells, 3 * n_cells);
+      dealii::DynamicSparsityPattern dsp(relevant_dofs);
       const auto block = [&](const unsigned int p, const unsigned int q) {
-        for (unsigned int i = 0; i < 3; ++i)
-          for (unsigned int j = 0; j < 3; ++j)
-            dsp.add(3 * p + i, 3 * q + j);
+        for (unsigned int i = 0; i < n_dofs; ++i)
+          for (unsigned int j = 0; j < n_dofs; ++j)
+            dsp.add(n_dofs * cell_block[p] + i, n_dofs * cell_block[q] + j);
       };
-      for (unsigned int c = 0; c < n_cells; ++c)
-        if (cell_owner[c] == rank)
-          block(c, c);
-      for (const unsigned int e : owned_facets)
-        {
-          const Facet<2> &f = network.facets[e];
-          for (const unsigned int p : {f.a, f.b})
-            {
-              relevant.add_range(3 * p, 3 * p + 3);
-              for (const unsigned int q : {f.a, f.b})
-                block(p, q);
-            }
-        }
-      relevant.compress();
-      dealii::SparsityTools::distribute_sparsity_pattern(dsp, owned_dofs, comm, relevant);
+      for (unsigned int c = 0; c < n_owned_cells; ++c)
+        block(c, c);
+      for (const auto &f : network.facets)
+        for (const unsigned int p : {f.a, f.b})
+          for (const unsigned int q : {f.a, f.b})
+            block(p, q);
+      if (distributed())
+        dealii::SparsityTools::distribute_sparsity_pattern(dsp, owned_dofs, comm, relevant_dofs);
       parallel_matrix.reinit(owned_dofs, owned_dofs, dsp, comm);
       if (distributed())
-        scene.console() << "rbsn: " << n_ranks << " MPI ranks, " << owned_facets.size() << " of "
-                        << network.facets.size() << " facets on rank " << rank << std::endl;
+        scene.console() << "rbsn: " << n_parts << " MPI ranks, " << network.facets.size() << " of "
+                        << n_global_facets << " facets and " << n_owned_cells << " of " << nuclei.size()
+                        << " cells on rank 0" << std::endl;
     }
 
 
 
+    template <int dim>
     void
-    Model::sum_over_ranks(Vector &x) const
-    {
-      if (!distributed())
-        return;
-      const MPI_Comm comm = scene.mpi_communicator();
-      // Then the root's sum to all: the same bits everywhere, whatever the reduction order.
-      int ierr = MPI_Allreduce(MPI_IN_PLACE, x.data(), x.size(), MPI_DOUBLE, MPI_SUM, comm);
-      AssertThrowMPI(ierr);
-      ierr = MPI_Bcast(x.data(), x.size(), MPI_DOUBLE, 0, comm);
-      AssertThrowMPI(ierr);
-    }
-
-
-
-    void
-    Model::synchronize_springs()
-    {
-      if (!distributed())
-        return;
-      const MPI_Comm comm = scene.mpi_communicator();
-      // Per facet: delta, force, trial delta, trial force (3 each), the tangent (9) and
-      // the spring law's converged and trial states.
-      const auto pack = [](const Springs &sp, std::vector<double> &buffer) {
-        for (const auto *a : {&sp.delta, &sp.force, &sp.trial_delta, &sp.trial_force})
-          buffer.insert(buffer.end(), a->begin(), a->end());
-        for (unsigned int i = 0; i < 3; ++i)
-          for (unsigned int j = 0; j < 3; ++j)
-            buffer.push_back(sp.tangent[i][j]);
-        buffer.insert(buffer.end(), sp.state.begin(), sp.state.end());
-        buffer.insert(buffer.end(), sp.trial_state.begin(), sp.trial_state.end());
-      };
-      std::vector<double> mine;
-      for (const unsigned int e : owned_facets)
-        pack(springs[e], mine);
-      std::vector<int> counts(n_ranks), offsets(n_ranks, 0);
-      const int        n_mine = mine.size();
-      int ierr = MPI_Allgather(&n_mine, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
-      AssertThrowMPI(ierr);
-      for (unsigned int r = 1; r < n_ranks; ++r)
-        offsets[r] = offsets[r - 1] + counts[r - 1];
-      std::vector<double> all(offsets.back() + counts.back());
-      ierr = MPI_Allgatherv(mine.data(), n_mine, MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
-                            MPI_DOUBLE, comm);
-      AssertThrowMPI(ierr);
-      // Each rank's facets in increasing order, as that rank packed them.
-      std::vector<std::size_t> position(n_ranks);
-      for (unsigned int r = 0; r < n_ranks; ++r)
-        position[r] = offsets[r];
-      for (unsigned int e = 0; e < springs.size(); ++e)
-        {
-          const unsigned int owner = cell_owner[network.facets[e].a];
-          const double      *p     = all.data() + position[owner];
-          Springs           &sp    = springs[e];
-          for (auto *a : {&sp.delta, &sp.force, &sp.trial_delta, &sp.trial_force})
-            for (auto &x : *a)
-              x = *p++;
-          for (unsigned int i = 0; i < 3; ++i)
-            for (unsigned int j = 0; j < 3; ++j)
-              sp.tangent[i][j] = *p++;
-          for (auto &x : sp.state)
-            x = *p++;
-          for (auto &x : sp.trial_state)
-            x = *p++;
-          position[owner] = p - all.data();
-        }
-    }
-
-
-
-    void
-    Model::add_local(const dealii::FullMatrix<double>                     &K,
-                     const dealii::Vector<double>                         &r,
-                     const std::vector<dealii::types::global_dof_index> &dofs,
-                     const bool                                           with_matrix)
+    Model<dim>::add_local(const dealii::FullMatrix<double> &K,
+                          const dealii::Vector<double>     &r,
+                          const std::vector<dof_index>     &dofs,
+                          const bool                        with_matrix)
     {
       if (!with_matrix)
         constraints.distribute_local_to_global(r, dofs, rhs);
@@ -194,10 +107,11 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Model::add_local_rhs(const dealii::FullMatrix<double>                     &K,
-                         const dealii::Vector<double>                         &r,
-                         const std::vector<dealii::types::global_dof_index> &dofs)
+    Model<dim>::add_local_rhs(const dealii::FullMatrix<double> &K,
+                              const dealii::Vector<double>     &r,
+                              const std::vector<dof_index>     &dofs)
     {
       // Free rows: r less the columns of the prescribed increments g (-K g).
       constraints.distribute_local_to_global(r, dofs, rhs, K);
@@ -222,8 +136,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Model::add_local_change(dealii::FullMatrix<double> &K, const std::vector<dealii::types::global_dof_index> &dofs)
+    Model<dim>::add_local_change(dealii::FullMatrix<double> &K, const std::vector<dof_index> &dofs)
     {
       // The constrained rows and columns are empty but for the diagonal of the last full
       // assembly, which they keep.
@@ -239,12 +154,13 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Model::solve_distributed(Vector &x)
+    Model<dim>::solve_distributed(Vector &x)
     {
       using namespace dealii;
-      const MPI_Comm comm = scene.mpi_communicator();
-      const bool renew = renew_factors();
+      const MPI_Comm comm  = network_communicator();
+      const bool     renew = renew_factors();
       if (linear_solver != "direct")
         return solve_iterative(x, renew);
       if (distributed_solver == "UMFPACK")
@@ -263,9 +179,7 @@ namespace hysteron
               factorized = true;
               ++n_factorizations;
             }
-          for (const auto i : owned_dofs)
-            b(i) = rhs(i);
-          b.compress(VectorOperation::insert);
+          std::copy(rhs.begin(), rhs.begin() + rhs.locally_owned_size(), b.begin());
           parallel_direct->solve(y, b);
           // Iterative refinement against the factorized matrix (the rotations' stiffness
           // k l^2 / 12 is far below the translations' k: the pivots lose digits).
@@ -285,19 +199,19 @@ namespace hysteron
         {
           throw singular_tangent();
         }
-      x = 0;
-      for (const auto i : owned_dofs)
-        x(i) = y(i);
-      sum_over_ranks(x);
+      std::copy(y.begin(), y.end(), x.begin());
     }
 
 
 
+    template <int dim>
     void
-    Model::solve_gathered(Vector &x, const bool renew)
+    Model<dim>::solve_gathered(Vector &x, const bool renew)
     {
       using namespace dealii;
-      const MPI_Comm comm = scene.mpi_communicator();
+      const MPI_Comm     comm    = network_communicator();
+      const unsigned int n_ranks = Utilities::MPI::n_mpi_processes(comm);
+      const bool         root    = Utilities::MPI::this_mpi_process(comm) == 0;
       if (renew)
         {
           // Every rank's rows (global row, length, then column and value pairs) to rank 0,
@@ -306,8 +220,8 @@ namespace hysteron
           const Epetra_CrsMatrix &A = parallel_matrix.trilinos_matrix();
           for (int i = 0; i < A.NumMyRows(); ++i)
             {
-              int     n = 0;
-              double *values = nullptr;
+              int     n       = 0;
+              double *values  = nullptr;
               int    *columns = nullptr;
               A.ExtractMyRowView(i, n, values, columns);
               rows.push_back(TrilinosWrappers::global_index(A.RowMap(), i));
@@ -324,12 +238,12 @@ namespace hysteron
           AssertThrowMPI(ierr);
           for (unsigned int r = 1; r < n_ranks; ++r)
             offsets[r] = offsets[r - 1] + counts[r - 1];
-          std::vector<double> all(rank == 0 ? offsets.back() + counts.back() : 0);
+          std::vector<double> all(root ? offsets.back() + counts.back() : 0);
           ierr = MPI_Gatherv(rows.data(), n_mine, MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
                              MPI_DOUBLE, 0, comm);
           AssertThrowMPI(ierr);
           int singular = 0;
-          if (rank == 0)
+          if (root)
             {
               matrix = 0;
               for (std::size_t p = 0; p < all.size();)
@@ -357,52 +271,68 @@ namespace hysteron
           factorized = true;
           ++n_factorizations;
         }
-      // The right-hand side is replicated: rank 0 solves and sends the solution.
-      if (rank == 0)
-        direct->solve(x, rhs);
-      const int ierr = MPI_Bcast(x.data(), x.size(), MPI_DOUBLE, 0, comm);
+      // The right-hand side's ranges (rank by rank, in the order of the DoFs) to rank 0,
+      // which solves and sends each rank its range of the solution.
+      const int        n_mine = rhs.locally_owned_size();
+      std::vector<int> counts(n_ranks), offsets(n_ranks, 0);
+      int              ierr = MPI_Allgather(&n_mine, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+      AssertThrowMPI(ierr);
+      for (unsigned int r = 1; r < n_ranks; ++r)
+        offsets[r] = offsets[r - 1] + counts[r - 1];
+      dealii::Vector<double> b(root ? rhs.size() : 0), y(root ? rhs.size() : 0);
+      ierr = MPI_Gatherv(rhs.begin(), n_mine, MPI_DOUBLE, b.data(), counts.data(), offsets.data(), MPI_DOUBLE, 0, comm);
+      AssertThrowMPI(ierr);
+      if (root)
+        direct->solve(y, b);
+      ierr = MPI_Scatterv(y.data(), counts.data(), offsets.data(), MPI_DOUBLE, x.begin(), n_mine, MPI_DOUBLE, 0, comm);
       AssertThrowMPI(ierr);
     }
 
 
 
+    template <int dim>
     void
-    Model::solve_iterative(Vector &x, const bool renew)
+    Model<dim>::solve_iterative(Vector &x, const bool renew)
     {
       using namespace dealii;
-      const MPI_Comm comm = scene.mpi_communicator();
+      const MPI_Comm comm = network_communicator();
       if (renew || !amg)
         {
           // ML aggregation with the null space of the network: per cell the translations
-          // (1, 0, 0), (0, 1, 0) and the rotation (-(y - y_0), x - x_0, 1) about the centre.
+          // and the rotations about the centre of the network (2D: (-(y - y_0), x - x_0, 1);
+          // 3D: the displacement e_j x r and the rotation e_j about each axis e_j).
           TrilinosWrappers::PreconditionAMG::AdditionalData data(true, false, 1, false, 1e-4, {}, 2, 0, false,
                                                                  "Chebyshev", "Amesos-KLU");
           Teuchos::ParameterList              list;
           std::unique_ptr<Epetra_MultiVector> constant_modes;
           data.set_parameters(list, constant_modes, parallel_matrix);
-          const Epetra_Map &map     = parallel_matrix.trilinos_matrix().RowMap();
-          const int         n_local = map.NumMyElements();
-          dealii::Point<2>  lo(1e300, 1e300), hi(-1e300, -1e300);
-          for (const auto &cell : network.cells)
-            for (unsigned int d = 0; d < 2; ++d)
-              {
-                lo[d] = std::min(lo[d], cell.nucleus[d]);
-                hi[d] = std::max(hi[d], cell.nucleus[d]);
-              }
-          const dealii::Point<2> centre = 0.5 * (lo + hi);
-          null_space.assign(3 * n_local, 0.0);
+          const Epetra_Map        &map     = parallel_matrix.trilinos_matrix().RowMap();
+          const int                n_local = map.NumMyElements();
+          const dealii::Point<dim> centre  = 0.5 * (nuclei_box[0] + nuclei_box[1]);
+          constexpr unsigned int   n_modes = n_dofs;
+          null_space.assign(n_modes * n_local, 0.0);
           for (int i = 0; i < n_local; ++i)
             {
-              const auto               g = TrilinosWrappers::global_index(map, i);
-              const unsigned int       k = g % 3;
-              const dealii::Tensor<1, 2> r = network.cells[g / 3].nucleus - centre;
-              null_space[i]               = k == 0 ? 1.0 : 0.0;
-              null_space[n_local + i]     = k == 1 ? 1.0 : 0.0;
-              null_space[2 * n_local + i] = k == 0 ? -r[1] : k == 1 ? r[0] : 1.0;
+              const auto                   g = TrilinosWrappers::global_index(map, i);
+              const unsigned int           k = g % n_dofs;
+              const unsigned int           c = (g - owned_dofs.nth_index_in_set(0)) / n_dofs;
+              const dealii::Tensor<1, dim> r = nuclei[cell_id[c]] - centre;
+              for (unsigned int m = 0; m < dim; ++m)
+                null_space[m * n_local + i] = k == m ? 1.0 : 0.0;
+              if constexpr (dim == 2)
+                null_space[2 * n_local + i] = k == 0 ? -r[1] : k == 1 ? r[0] : 1.0;
+              else
+                for (unsigned int j = 0; j < 3; ++j)
+                  {
+                    dealii::Tensor<1, 3> axis;
+                    axis[j]                          = 1;
+                    const dealii::Tensor<1, 3> moved = dealii::cross_product_3d(axis, r);
+                    null_space[(3 + j) * n_local + i] = k < 3 ? moved[k] : (k - 3 == j ? 1.0 : 0.0);
+                  }
             }
-          list.set("PDE equations", 3);
+          list.set("PDE equations", int(n_dofs));
           list.set("null space: type", "pre-computed");
-          list.set("null space: dimension", 3);
+          list.set("null space: dimension", int(n_modes));
           list.set("null space: vectors", null_space.data());
           amg = std::make_unique<TrilinosWrappers::PreconditionAMG>();
           amg->initialize(parallel_matrix.trilinos_matrix(), list);
@@ -411,9 +341,7 @@ namespace hysteron
           ++n_factorizations;
         }
       TrilinosWrappers::MPI::Vector b(owned_dofs, comm), y(owned_dofs, comm);
-      for (const auto i : owned_dofs)
-        b(i) = rhs(i);
-      b.compress(VectorOperation::insert);
+      std::copy(rhs.begin(), rhs.begin() + rhs.locally_owned_size(), b.begin());
       SolverControl control(solver_max_iterations, std::max(1e-300, solver_tolerance * b.l2_norm()));
       try
         {
@@ -433,10 +361,12 @@ namespace hysteron
           throw RuntimeError(m.str());
         }
       n_linear_iterations += control.last_step();
-      x = 0;
-      for (const auto i : owned_dofs)
-        x(i) = y(i);
-      sum_over_ranks(x);
+      std::copy(y.begin(), y.end(), x.begin());
     }
+
+
+
+    template class Model<2>;
+    template class Model<3>;
   } // namespace RBSN
 } // namespace hysteron

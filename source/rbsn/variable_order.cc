@@ -16,7 +16,7 @@
  * Analysis = variable order: the state-space form of eq. 3.43-3.48 as an
  * implicit DAE F(t, y, y') = 0 in y = (u, v, s, W), integrated by SUNDIALS IDA
  * (variable-order, variable-step BDF with local error control) through deal.II's
- * wrapper. With n = 3 cells DoFs, s the Bouc-Wen states of the hysteretic springs
+ * wrapper. With n = 3 (2D) or 6 (3D) DoFs per cell, s the Bouc-Wen states of the hysteretic springs
  * (z, and eta, e_h with degradation), and W three work quadratures:
  *
  *   free DoF i:        u_i' - v_i = 0,
@@ -67,8 +67,9 @@ namespace hysteron
 {
   namespace RBSN
   {
+    template <int dim>
     void
-    Model::declare_variable_order_parameters(dealii::ParameterHandler &prm)
+    Model<dim>::declare_variable_order_parameters(dealii::ParameterHandler &prm)
     {
       using namespace dealii;
       prm.enter_subsection("Variable order");
@@ -95,8 +96,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Model::parse_variable_order_parameters(dealii::ParameterHandler &prm)
+    Model<dim>::parse_variable_order_parameters(dealii::ParameterHandler &prm)
     {
       Section s(prm, {"RBSN", "Variable order"});
       auto   &p            = variable_order;
@@ -125,10 +127,14 @@ namespace hysteron
 
 
     /// The DAE of the variable-order analysis and its Newton matrix (see the top of the file).
-    class Model::VariableOrder
+    template <int dim>
+    class Model<dim>::VariableOrder
     {
     public:
-      explicit VariableOrder(Model &model);
+      using Vector = dealii::Vector<double>; ///< IDA's vectors (the whole network on every rank)
+      static constexpr unsigned int n_dofs = Model<dim>::n_dofs;
+
+      explicit VariableOrder(Model<dim> &model);
 
       /// F(t, y, y'); returns 0, or 1 (recoverable: IDA retries with a smaller step).
       int
@@ -157,15 +163,16 @@ namespace hysteron
       }
 
     private:
-      Model       &m;
+      Model<dim>  &m;
       unsigned int n = 0, n_states = 0, n_total = 0;
       /// Per spring (index 3 e + i): the offset of its Bouc-Wen state within s, -1 if linear.
       std::vector<int>              state_offset;
       /// Per spring (index 3 e + i) of a hysteretic facet: its uniaxial law and the
       /// offset of its state in the facet's state (SpringLaw<2>::uniaxial_spring()).
-      std::vector<SpringLaw<2>::UniaxialSpring> uniaxial;
+      std::vector<typename SpringLaw<dim>::UniaxialSpring> uniaxial;
       std::vector<double>           w; ///< prescribed velocities at the last t
-      Vector                        reaction, f_ext;
+      Vector                        reaction;
+      typename Model<dim>::Vector   f_ext; ///< the model's layout (one part: all DoFs)
       dealii::SparsityPattern       pattern;
       dealii::SparseMatrix<double>  jacobian;
       SparseLU                      direct; ///< the symbolic analysis kept over the Jacobians
@@ -173,54 +180,54 @@ namespace hysteron
       const Material::BoucWenUniaxial &
       law(const unsigned int e, const unsigned int i) const
       {
-        return *uniaxial[3 * e + i].law;
+        return *uniaxial[n_dofs * e + i].law;
       }
       /// Spring i's state in the facet's state.
       unsigned int
       facet_offset(const unsigned int e, const unsigned int i) const
       {
-        return uniaxial[3 * e + i].offset;
+        return uniaxial[n_dofs * e + i].offset;
       }
       unsigned int
       s_index(const unsigned int e, const unsigned int i) const
       {
-        return 2 * n + state_offset[3 * e + i];
+        return 2 * n + state_offset[n_dofs * e + i];
       }
       void
       prescribed_velocities(const double t);
-      /// The facet's six DoF indices.
-      std::array<unsigned int, 6>
+      /// The facet's DoF indices (a's, then b's).
+      std::array<unsigned int, 2 * n_dofs>
       facet_dofs(const unsigned int e) const
       {
-        const Facet<2> &f = m.network.facets[e];
-        return {{3 * f.a, 3 * f.a + 1, 3 * f.a + 2, 3 * f.b, 3 * f.b + 1, 3 * f.b + 2}};
+        return m.facet_local_dofs(e);
       }
     };
 
 
 
-    Model::VariableOrder::VariableOrder(Model &model)
+    template <int dim>
+    Model<dim>::VariableOrder::VariableOrder(Model<dim> &model)
       : m(model)
       , n(model.u.size())
     {
-      state_offset.assign(3 * m.springs.size(), -1);
-      uniaxial.assign(3 * m.springs.size(), SpringLaw<2>::UniaxialSpring());
+      state_offset.assign(n_dofs * m.springs.size(), -1);
+      uniaxial.assign(n_dofs * m.springs.size(), typename SpringLaw<dim>::UniaxialSpring());
       for (unsigned int e = 0; e < m.springs.size(); ++e)
         if (m.springs[e].hysteretic)
-          for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int i = 0; i < n_dofs; ++i)
             {
-              uniaxial[3 * e + i] = m.spring_law->uniaxial_spring(e, i);
-              if (uniaxial[3 * e + i].law == nullptr)
+              uniaxial[n_dofs * e + i] = m.spring_law->uniaxial_spring(e, i);
+              if (uniaxial[n_dofs * e + i].law == nullptr)
                 throw std::logic_error("rbsn: the spring law '" + m.spring_law_name +
                                        "' supports the variable-order analysis but gives no "
                                        "uniaxial law of a spring");
-              state_offset[3 * e + i] = n_states;
+              state_offset[n_dofs * e + i] = n_states;
               n_states += law(e, i).n_state_variables();
             }
       n_total = 2 * n + n_states + 3;
       w.assign(n, 0.0);
       reaction.reinit(n);
-      f_ext.reinit(n);
+      f_ext.reinit(m.partitioner);
 
       // The Newton matrix's pattern: kinematic rows (u_i, u_i), (u_i, v_i); the cells'
       // mass blocks; per facet the (v, u) and (v, v) blocks of its two cells, the
@@ -231,10 +238,10 @@ namespace hysteron
           dsp.add(i, i);
           dsp.add(i, n + i);
         }
-      for (unsigned int c = 0; c < m.network.cells.size(); ++c)
-        for (unsigned int p = 0; p < 3; ++p)
-          for (unsigned int q = 0; q < 3; ++q)
-            dsp.add(n + 3 * c + p, n + 3 * c + q);
+      for (unsigned int c = 0; c < m.n_owned_cells; ++c)
+        for (unsigned int p = 0; p < n_dofs; ++p)
+          for (unsigned int q = 0; q < n_dofs; ++q)
+            dsp.add(n + n_dofs * c + p, n + n_dofs * c + q);
       for (unsigned int e = 0; e < m.springs.size(); ++e)
         {
           const auto dofs = facet_dofs(e);
@@ -244,9 +251,9 @@ namespace hysteron
                 dsp.add(n + p, q);
                 dsp.add(n + p, n + q);
               }
-          if (state_offset[3 * e] < 0)
+          if (state_offset[n_dofs * e] < 0)
             continue;
-          for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int i = 0; i < n_dofs; ++i)
             {
               const unsigned int k = law(e, i).n_state_variables(), s0 = s_index(e, i);
               for (const unsigned int p : dofs)
@@ -274,16 +281,16 @@ namespace hysteron
       tolerances.reinit(n_total);
       for (unsigned int i = 0; i < n; ++i)
         {
-          tolerances(i)     = i % 3 == 2 ? atol / m.scale : atol;
+          tolerances(i)     = i % n_dofs >= dim ? atol / m.scale : atol;
           tolerances(n + i) = tolerances(i) / t_out;
         }
       for (unsigned int e = 0; e < m.springs.size(); ++e)
-        if (state_offset[3 * e] >= 0)
-          for (unsigned int i = 0; i < 3; ++i)
+        if (state_offset[n_dofs * e] >= 0)
+          for (unsigned int i = 0; i < n_dofs; ++i)
             {
               const auto        &spring = law(e, i);
               const unsigned int s0     = s_index(e, i);
-              tolerances(s0)            = i == 2 ? atol / m.scale : atol;
+              tolerances(s0)            = i >= dim ? atol / m.scale : atol;
               if (spring.degradation())
                 {
                   tolerances(s0 + Material::BoucWenUniaxial::eta_index)    = p.relative_tolerance;
@@ -302,8 +309,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     dealii::IndexSet
-    Model::VariableOrder::differential_components() const
+    Model<dim>::VariableOrder::differential_components() const
     {
       // All but the velocities of the prescribed DoFs.
       dealii::IndexSet set(n_total);
@@ -318,8 +326,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Model::VariableOrder::prescribed_velocities(const double t)
+    Model<dim>::VariableOrder::prescribed_velocities(const double t)
     {
       for (unsigned int i = 0; i < n; ++i)
         w[i] = m.dof_set[i] >= 0 ? m.prescribed_velocity(m.dirichlet[m.dof_set[i]], i, t) : 0.0;
@@ -327,8 +336,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     int
-    Model::VariableOrder::residual(const double t, const Vector &y, const Vector &yp, Vector &F)
+    Model<dim>::VariableOrder::residual(const double t, const Vector &y, const Vector &yp, Vector &F)
     {
       prescribed_velocities(t);
       m.external_forces(t, f_ext);
@@ -346,27 +356,28 @@ namespace hysteron
 
       // reaction = M (v' + a0 v) + f_int + a1 K0 v - f_ext on every DoF.
       reaction = 0;
-      reaction -= f_ext;
-      dealii::FullMatrix<double> M(3, 3);
-      for (unsigned int c = 0; c < m.network.cells.size(); ++c)
+      for (unsigned int i = 0; i < n; ++i)
+        reaction(i) -= f_ext.local_element(i);
+      dealii::FullMatrix<double> M(n_dofs, n_dofs);
+      for (unsigned int c = 0; c < m.n_owned_cells; ++c)
         {
           m.cell_mass_matrix(c, M);
-          for (unsigned int p = 0; p < 3; ++p)
-            for (unsigned int q = 0; q < 3; ++q)
-              reaction(3 * c + p) += M(p, q) * (yp(n + 3 * c + q) + a0 * y(n + 3 * c + q));
+          for (unsigned int p = 0; p < n_dofs; ++p)
+            for (unsigned int q = 0; q < n_dofs; ++q)
+              reaction(n_dofs * c + p) += M(p, q) * (yp(n + n_dofs * c + q) + a0 * y(n + n_dofs * c + q));
         }
       double power_int = 0, power_ext = 0, power_bnd = 0;
-      std::array<double, 6> U, V;
+      std::array<double, 2 * n_dofs> U, V;
       for (unsigned int e = 0; e < m.springs.size(); ++e)
         {
-          const Springs &sp   = m.springs[e];
-          const auto     dofs = facet_dofs(e);
-          for (unsigned int k = 0; k < 6; ++k)
+          const Springs<dim> &sp   = m.springs[e];
+          const auto          dofs = facet_dofs(e);
+          for (unsigned int k = 0; k < 2 * n_dofs; ++k)
             {
               U[k] = y(dofs[k]);
               V[k] = y(n + dofs[k]);
             }
-          for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int i = 0; i < n_dofs; ++i)
             {
               const double delta = sp.deformation(i, U), rate = sp.deformation(i, V);
               double       force = sp.k[i] * delta;
@@ -385,13 +396,13 @@ namespace hysteron
                 }
               power_int += force * rate;
               const double total = force + a1 * sp.k[i] * rate;
-              for (unsigned int k = 0; k < 6; ++k)
-                reaction(dofs[k]) += sp.B(i, k) * total;
+              for (unsigned int k = 0; k < 2 * n_dofs; ++k)
+                reaction(dofs[k]) += sp.B[i][k] * total;
             }
         }
       for (unsigned int i = 0; i < n; ++i)
         {
-          power_ext += f_ext(i) * y(n + i);
+          power_ext += f_ext.local_element(i) * y(n + i);
           if (m.dof_set[i] < 0)
             F(n + i) = reaction(i);
           else
@@ -406,8 +417,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     int
-    Model::VariableOrder::setup_jacobian(const Vector &y, const double cj)
+    Model<dim>::VariableOrder::setup_jacobian(const Vector &y, const double cj)
     {
       const double a0 = m.dynamics.rayleigh_mass, a1 = m.dynamics.rayleigh_stiffness;
       jacobian = 0;
@@ -422,35 +434,36 @@ namespace hysteron
       // The prescribed DoFs' v rows are v_i - w_i(t): only the rows of free DoFs get
       // the equation of motion's derivatives.
       const auto free = [&](const unsigned int i) { return m.dof_set[i] < 0; };
-      dealii::FullMatrix<double> M(3, 3);
-      for (unsigned int c = 0; c < m.network.cells.size(); ++c)
+      dealii::FullMatrix<double> M(n_dofs, n_dofs);
+      for (unsigned int c = 0; c < m.n_owned_cells; ++c)
         {
           m.cell_mass_matrix(c, M);
-          for (unsigned int p = 0; p < 3; ++p)
-            if (free(3 * c + p))
-              for (unsigned int q = 0; q < 3; ++q)
-                jacobian.add(n + 3 * c + p, n + 3 * c + q, (cj + a0) * M(p, q));
+          for (unsigned int p = 0; p < n_dofs; ++p)
+            if (free(n_dofs * c + p))
+              for (unsigned int q = 0; q < n_dofs; ++q)
+                jacobian.add(n + n_dofs * c + p, n + n_dofs * c + q, (cj + a0) * M(p, q));
         }
-      std::array<double, 6> U, V;
+      std::array<double, 2 * n_dofs> U, V;
       for (unsigned int e = 0; e < m.springs.size(); ++e)
         {
-          const Springs &sp   = m.springs[e];
-          const auto     dofs = facet_dofs(e);
-          for (unsigned int k = 0; k < 6; ++k)
+          const Springs<dim> &sp   = m.springs[e];
+          const auto          dofs = facet_dofs(e);
+          for (unsigned int k = 0; k < 2 * n_dofs; ++k)
             {
               U[k] = y(dofs[k]);
               V[k] = y(n + dofs[k]);
             }
-          for (unsigned int i = 0; i < 3; ++i)
+          (void)U;
+          for (unsigned int i = 0; i < n_dofs; ++i)
             {
               // dF/d delta = a k (the z part is a state of its own), dF/dz = (1 - a) k.
               const double a  = sp.hysteretic ? law(e, i).parameters().post_yield_ratio : 1.0;
               const double ka = a * sp.k[i], kv = a1 * sp.k[i], kz = (1 - a) * sp.k[i];
-              for (unsigned int p = 0; p < 6; ++p)
+              for (unsigned int p = 0; p < 2 * n_dofs; ++p)
                 if (free(dofs[p]))
-                  for (unsigned int q = 0; q < 6; ++q)
+                  for (unsigned int q = 0; q < 2 * n_dofs; ++q)
                     {
-                      const double BB = sp.B(i, p) * sp.B(i, q);
+                      const double BB = sp.B[i][p] * sp.B[i][q];
                       jacobian.add(n + dofs[p], dofs[q], ka * BB);
                       if (kv != 0)
                         jacobian.add(n + dofs[p], n + dofs[q], kv * BB);
@@ -459,9 +472,9 @@ namespace hysteron
                 continue;
               const auto        &spring = law(e, i);
               const unsigned int s0 = s_index(e, i), k = spring.n_state_variables();
-              for (unsigned int p = 0; p < 6; ++p)
+              for (unsigned int p = 0; p < 2 * n_dofs; ++p)
                 if (free(dofs[p]))
-                  jacobian.add(n + dofs[p], s0, sp.B(i, p) * kz);
+                  jacobian.add(n + dofs[p], s0, sp.B[i][p] * kz);
               // s' - R(s, B_i v): c_j I - dR/ds, and -dR/d delta' B_i in the v columns.
               double state[3], dR_ds[9], dR_dr[3];
               for (unsigned int j = 0; j < k; ++j)
@@ -471,9 +484,9 @@ namespace hysteron
                 {
                   for (unsigned int j = 0; j < k; ++j)
                     jacobian.add(s0 + r, s0 + j, (r == j ? cj : 0.0) - dR_ds[r * k + j]);
-                  for (unsigned int q = 0; q < 6; ++q)
-                    if (sp.B(i, q) != 0)
-                      jacobian.add(s0 + r, n + dofs[q], -dR_dr[r] * sp.B(i, q));
+                  for (unsigned int q = 0; q < 2 * n_dofs; ++q)
+                    if (sp.B[i][q] != 0)
+                      jacobian.add(s0 + r, n + dofs[q], -dR_dr[r] * sp.B[i][q]);
                 }
             }
         }
@@ -492,8 +505,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     int
-    Model::VariableOrder::solve(const Vector &rhs, Vector &x)
+    Model<dim>::VariableOrder::solve(const Vector &rhs, Vector &x)
     {
       try
         {
@@ -508,8 +522,9 @@ namespace hysteron
 
 
 
+    template <int dim>
     void
-    Model::VariableOrder::initial_values(Vector &y, Vector &yp)
+    Model<dim>::VariableOrder::initial_values(Vector &y, Vector &yp)
     {
       // y(0): the model's initial state, the prescribed velocities w(0); y'(0): the
       // rates of the residual at y' = 0 (F = y' - rate for u, s and W), the
@@ -519,12 +534,12 @@ namespace hysteron
       yp.reinit(n_total);
       for (unsigned int i = 0; i < n; ++i)
         {
-          y(i)     = m.u(i);
-          y(n + i) = m.dof_set[i] < 0 ? m.v(i) : w[i];
+          y(i)     = m.u.local_element(i);
+          y(n + i) = m.dof_set[i] < 0 ? m.v.local_element(i) : w[i];
         }
       for (unsigned int e = 0; e < m.springs.size(); ++e)
-        if (state_offset[3 * e] >= 0)
-          for (unsigned int i = 0; i < 3; ++i)
+        if (state_offset[n_dofs * e] >= 0)
+          for (unsigned int i = 0; i < n_dofs; ++i)
             for (unsigned int j = 0; j < law(e, i).n_state_variables(); ++j)
               y(s_index(e, i) + j) = m.springs[e].state[facet_offset(e, i) + j];
       const unsigned int iw = 2 * n + n_states;
@@ -534,32 +549,33 @@ namespace hysteron
       Vector F(n_total);
       residual(0, y, yp, F);
       for (unsigned int j = 0; j < n_total; ++j)
-        yp(j) = j >= n && j < 2 * n ? (m.dof_set[j - n] < 0 ? m.a(j - n) : 0.0) : -F(j);
+        yp(j) = j >= n && j < 2 * n ? (m.dof_set[j - n] < 0 ? m.a.local_element(j - n) : 0.0) : -F(j);
     }
 
 
 
+    template <int dim>
     void
-    Model::VariableOrder::to_model(const double t, const Vector &y, const Vector &yp)
+    Model<dim>::VariableOrder::to_model(const double t, const Vector &y, const Vector &yp)
     {
       Vector F(n_total);
       residual(t, y, yp, F); // reaction = f_int + M v' + C v - f_ext, f_ext at t
       m.f_ext = f_ext;
       m.f_ext_old = f_ext; // the converged external force (history tables)
-      std::array<double, 6> U;
+      std::array<double, 2 * n_dofs> U;
       for (unsigned int i = 0; i < n; ++i)
         {
-          m.u(i) = y(i);
-          m.v(i) = y(n + i);
-          m.a(i) = yp(n + i);
+          m.u.local_element(i) = y(i);
+          m.v.local_element(i) = y(n + i);
+          m.a.local_element(i) = yp(n + i);
         }
       for (unsigned int e = 0; e < m.springs.size(); ++e)
         {
-          Springs   &sp   = m.springs[e];
-          const auto dofs = facet_dofs(e);
-          for (unsigned int k = 0; k < 6; ++k)
+          Springs<dim> &sp   = m.springs[e];
+          const auto    dofs = facet_dofs(e);
+          for (unsigned int k = 0; k < 2 * n_dofs; ++k)
             U[k] = y(dofs[k]);
-          for (unsigned int i = 0; i < 3; ++i)
+          for (unsigned int i = 0; i < n_dofs; ++i)
             {
               sp.delta[i] = sp.deformation(i, U);
               if (sp.hysteretic)
@@ -577,7 +593,8 @@ namespace hysteron
           sp.trial_state = sp.state;
         }
       // The output's reactions: f_int + M v' + C v - f_ext.
-      m.reaction_old = reaction;
+      for (unsigned int i = 0; i < n; ++i)
+        m.reaction_old.local_element(i) = reaction(i);
       m.u_trial = m.u;
       const unsigned int iw = 2 * n + n_states;
       m.internal_work       = y(iw);
@@ -587,13 +604,15 @@ namespace hysteron
 
 
 
+    template <int dim>
     double
-    Model::integrate_variable_order(const double                       output_interval,
+    Model<dim>::integrate_variable_order(const double                       output_interval,
                                     const std::function<void(double)> &step_finished)
     {
       const auto  &p        = variable_order;
       const double end_time = scene.time_control().end_time;
       VariableOrder dae(*this);
+      using Vector = dealii::Vector<double>;
 
       using Data = Ida::AdditionalData;
       Data data(0,
@@ -690,5 +709,8 @@ namespace hysteron
       ida.solve_dae(y, yp);
       return end_time;
     }
+
+    template class Model<2>;
+    template class Model<3>;
   } // namespace RBSN
 } // namespace hysteron

@@ -39,9 +39,10 @@ namespace hysteron
     void
     add_displacement(const unsigned int part, const dealii::Point<dim> &x, const unsigned int direction);
 
-    /// A prescribed rotation DoF (2D rigid-body-spring cells: theta about z).
+    /// A prescribed rotation DoF of a rigid-body-spring cell about the axis @p axis (2D:
+    /// theta about z, axis 0; 3D: 0, 1, 2 for x, y, z).
     void
-    add_rotation(const unsigned int part);
+    add_rotation(const unsigned int part, const unsigned int axis = 0);
 
     /// Add the other ranks' supports.
     void

@@ -1,21 +1,23 @@
 #ifndef hysteron_rbsn_model_h
 #define hysteron_rbsn_model_h
 
+#include <deal.II/base/index_set.h>
+#include <deal.II/base/partitioner.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/la_parallel_vector.h>
+#include <deal.II/lac/solver_control.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/sparsity_pattern.h>
-#include <deal.II/base/index_set.h>
-#include <deal.II/lac/solver_control.h>
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_solver.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 
+#include <hysteron/base/checkpoint.h>
 #include <hysteron/base/implicit_dynamics.h>
 #include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>
-#include <hysteron/base/checkpoint.h>
 #include <hysteron/rbsn/spring_law.h>
 #include <hysteron/rbsn/tessellation.h>
 #include <hysteron/scene/method.h>
@@ -63,49 +65,64 @@ namespace hysteron
     };
 
     /**
-     * One facet's three springs (normal, tangential, rotational): stiffness, the
-     * converged and trial deformations, forces and state of the spring law (see
-     * SpringLaw), and the tangent D = dF / d delta of the last evaluation.
-     * Deformations delta = (delta_n, delta_t, phi) = B [u_a; u_b].
+     * One facet's springs (2D: normal, tangential, rotational; 3D: normal, two shear,
+     * two bending, torsion; see FacetSprings): stiffness, the converged and trial
+     * deformations, forces and state of the spring law (see SpringLaw), and the tangent
+     * D = dF / d delta of the last evaluation. The deformations are delta = B U_e with
+     * U_e the two cells' DoFs (a's, then b's).
      */
+    template <int dim>
     struct Springs
     {
-      std::array<double, 3> k{};
-      std::array<double, 3> delta{}, force{}, trial_delta{}, trial_force{};
-      SpringLaw<2>::Matrix     tangent;              ///< diag(k) for linear springs
-      std::vector<double>   state, trial_state;   ///< the law's (hysteretic springs only)
-      std::array<double, 6> B_n{}, B_t{}; ///< the rows n and t of B (the third is (0, 0, -1, 0, 0, 1))
-      double                thickness  = 1;
-      bool                  hysteretic = false; ///< the spring law's (else linear springs)
-      bool                  broken     = false;
+      static constexpr unsigned int n = n_springs<dim>; ///< springs (and DoFs per cell)
+      using Vector                    = typename SpringLaw<dim>::Vector;
 
-      /// B(i, k): row i (n, t, phi) of B, column k of U_e.
-      double
-      B(const unsigned int i, const unsigned int k) const
-      {
-        return i == 0 ? B_n[k] : i == 1 ? B_t[k] : (k == 5 ? 1.0 : k == 2 ? -1.0 : 0.0);
-      }
+      Vector                          k{};
+      Vector                          delta{}, force{}, trial_delta{}, trial_force{};
+      typename SpringLaw<dim>::Matrix tangent; ///< diag(k) for linear springs
+      std::vector<double>             state, trial_state; ///< the law's (hysteretic springs only)
+      /// B: row i (spring), column k of U_e (a's n DoFs, then b's).
+      std::array<std::array<double, 2 * n>, n> B{};
+      double                                   thickness  = 1; ///< 2D: t [m]; 3D: 1
+      double                                   area       = 1; ///< the facet's area (2D: t l) [m^2]
+      bool                                     hysteretic = false; ///< the spring law's (else linear springs)
+      bool                                     broken     = false;
 
-      /// The deformation (or its rate) B_i U of spring i for the facet's six DoF values @p U.
+      /// The deformation (or its rate) B_i U of spring i for the facet's DoF values @p U.
       template <typename VectorType>
       double
       deformation(const unsigned int i, const VectorType &U) const
       {
-        if (i == 2)
-          return U[5] - U[2];
-        const auto &row = i == 0 ? B_n : B_t;
-        double      s   = 0;
-        for (unsigned int k = 0; k < 6; ++k)
-          s += row[k] * U[k];
+        double s = 0;
+        for (unsigned int k = 0; k < 2 * n; ++k)
+          s += B[i][k] * U[k];
         return s;
       }
     };
 
-    /// The scene on the network (see Solver). Two-dimensional.
+    /**
+     * The scene on the network (see Solver), in 2D (cells with the DoFs u, v, theta)
+     * or 3D (u_x, u_y, u_z, theta_x, theta_y, theta_z).
+     *
+     * Under MPI the network is distributed: the nuclei (the points, 2 or 3 doubles per
+     * cell, and the rank of every cell) are the only data every rank holds for the
+     * whole network. The cells are split over the ranks by recursive coordinate
+     * bisection of the nuclei; each rank builds the Voronoi cells of its own nuclei
+     * from them and a halo of the nuclei around them, and owns the facets whose first
+     * cell (the lower number) is its own. The DoF vectors are distributed vectors with
+     * the neighbouring ("ghost") cells of other ranks, the tangent is a Trilinos matrix
+     * of the owned rows. The cells of a rank are numbered 0, 1, ...: its own first (in
+     * the order of their global numbers), then its ghost cells (in the order of their
+     * DoFs).
+     */
+    template <int dim>
     class Model
     {
     public:
-      Model(const Scene<2> &scene, const Methods::Interface<2> &method, dealii::ParameterHandler &prm);
+      /// DoFs per cell: 3 (u, v, theta) in 2D, 6 (translations, rotations) in 3D.
+      static constexpr unsigned int n_dofs = n_springs<dim>;
+
+      Model(const Scene<dim> &scene, const Methods::Interface<dim> &method, dealii::ParameterHandler &prm);
       ~Model();
 
       static void
@@ -154,35 +171,48 @@ namespace hysteron
       std::string
       summary(unsigned long steps, unsigned int outputs) const;
 
-      const Tessellation<2> &
-      tessellation() const
+      /// The number of cells of the whole network.
+      std::size_t
+      n_global_cells() const
       {
-        return network;
+        return nuclei.size();
       }
 
     private:
-      using Vector = dealii::Vector<double>;
+      using Vector       = dealii::LinearAlgebra::distributed::Vector<double>;
+      using SpringVector = typename SpringLaw<dim>::Vector;
+      using SpringMatrix = typename SpringLaw<dim>::Matrix;
+      using dof_index    = dealii::types::global_dof_index;
 
       /// A kinematic condition on cell DoFs (a scene boundary or a rigid body).
       struct Dirichlet
       {
         std::string               name;
         int                       boundary = -1, rigid = -1;
-        std::vector<unsigned int> dofs; ///< 3 cell + component (2 = rotation)
+        std::vector<unsigned int> dofs; ///< local DoFs: n_dofs local cell + component
       };
 
       /// A load on cells: a force and moment per cell, times the load's value.
       struct LoadSet
       {
-        unsigned int                        load = 0;
-        std::vector<unsigned int>           cells;
-        std::vector<dealii::Tensor<1, 2>>   arm;    ///< moment arm of each contribution (traction)
-        std::vector<double>                 weight; ///< force = weight value(t)
+        unsigned int                          load = 0;
+        std::vector<unsigned int>             cells;  ///< owned local cells
+        std::vector<dealii::Tensor<1, dim>>   arm;    ///< moment arm of each contribution (traction)
+        std::vector<double>                   weight; ///< force = weight value(t)
       };
 
       // Set-up.
+      /// The nuclei (every rank), their partition over the ranks, and this rank's cells,
+      /// ghost cells and facets with their mass properties (network.cc).
       void
       build_network();
+      /// This rank's part of the tessellation: the cells of @p owned (ascending global
+      /// numbers) and their facets, from a halo of nuclei around them.
+      void
+      build_local_tessellation(const std::vector<unsigned int> &owned);
+      /// Recursive coordinate bisection of the nuclei into @p n_parts parts of equal size.
+      std::vector<unsigned int>
+      partition_nuclei(unsigned int n_parts) const;
       void
       setup_springs();
       void
@@ -193,27 +223,38 @@ namespace hysteron
       void
       check_supports() const;
       /// The connected parts of the network over all its facets, or over the intact ones
-      /// with @p intact_only (the part of every cell into @p part), and for each part the
-      /// rigid-body motions its supports leave free (empty: held).
+      /// with @p intact_only: the part of every local cell into @p part (parts numbered in
+      /// the order of their lowest global cell number, the same on any number of ranks),
+      /// their number of cells into @p sizes, and for each part the rigid-body motions its
+      /// supports leave free (empty: held).
       std::vector<std::vector<std::string>>
-      network_parts(bool intact_only, std::vector<unsigned int> &part) const;
+      network_parts(bool intact_only, std::vector<unsigned int> &part, std::vector<unsigned long> &sizes) const;
 
       /// What a break did to the network (fracture.csv, console).
       struct Separation
       {
-        unsigned int         cells    = 0; ///< of the smaller fragment it cut off (0: none)
-        unsigned int         released = 0; ///< cells it released from the static system
-        dealii::Point<2>     centroid, released_centroid;
-        dealii::Tensor<1, 2> load; ///< the external force on the released cells [N]
+        unsigned long          cells    = 0; ///< of the smaller fragment it cut off (0: none)
+        unsigned long          released = 0; ///< cells it released from the static system
+        dealii::Point<dim>     centroid, released_centroid;
+        dealii::Tensor<1, dim> load; ///< the external force on the released cells [N]
       };
       /// The fragments over the intact facets, and (static analyses) the cells of the
       /// fragments that nothing holds: released, their DoFs keep their values.
       void
       update_fragments();
-      /// What the break of facet @p e did, after update_fragments(), given the released
-      /// cells before it.
+      /// What the break of the facet between the global cells @p a and @p b did, after
+      /// update_fragments(), given the released cells before it (every rank).
       Separation
-      separation(unsigned int e, const std::vector<bool> &released_before) const;
+      separation(unsigned int a, unsigned int b, const std::vector<bool> &released_before) const;
+      /// The area (2D) or volume (3D) of owned cell @p c.
+      double
+      cell_measure(const unsigned int c) const
+      {
+        if constexpr (dim == 2)
+          return network.cells[c].area;
+        else
+          return network.cells[c].volume;
+      }
 
       // Steps.
       void
@@ -226,12 +267,10 @@ namespace hysteron
       /// The right-hand side of a local matrix and vector as
       /// distribute_local_to_global(K, r, dofs, matrix, rhs, true) makes it, without the matrix.
       void
-      add_local_rhs(const dealii::FullMatrix<double>                     &K,
-                    const dealii::Vector<double>                         &r,
-                    const std::vector<dealii::types::global_dof_index> &dofs);
+      add_local_rhs(const dealii::FullMatrix<double> &K, const dealii::Vector<double> &r, const std::vector<dof_index> &dofs);
       /// Add the local matrix @p K to the free rows and columns of the system matrix.
       void
-      add_local_change(dealii::FullMatrix<double> &K, const std::vector<dealii::types::global_dof_index> &dofs);
+      add_local_change(dealii::FullMatrix<double> &K, const std::vector<dof_index> &dofs);
       bool
       solve_step(const double t, const double dt);
       /// One attempt of solve_step(): predictor and Newton iterations.
@@ -240,6 +279,7 @@ namespace hysteron
       /// Accept the trial state of a step of @p dt (in which facets @p broke).
       void
       commit(const double dt, const bool broke);
+      /// x = K^-1 rhs (the owned entries; the caller distributes the constraints).
       void
       solve_linear(Vector &x);
       /// Whether the factors (or the AMG hierarchy) must be rebuilt for the current matrix:
@@ -250,15 +290,12 @@ namespace hysteron
       static RuntimeError
       singular_tangent();
 
-      // MPI (parallel.cc): the cells are partitioned over the ranks (METIS on the cell
-      // graph); each rank evaluates the springs of its facets and assembles them into a
-      // distributed Trilinos matrix, solved by UMFPACK on rank 0 or Amesos (KLU, MUMPS). The network, the DoF vectors and
-      // (after every step) the springs' state are replicated on every rank.
-      /// More than one MPI rank.
+      // MPI (parallel.cc).
+      /// More than one part: the network is distributed over the ranks.
       bool
       distributed() const
       {
-        return n_ranks > 1;
+        return n_parts > 1;
       }
       /// The system is a Trilinos matrix (several ranks, or an iterative solver).
       bool
@@ -266,15 +303,14 @@ namespace hysteron
       {
         return distributed() || linear_solver != "direct";
       }
-      /// The owner of every cell and facet, the owned DoFs and the matrix's sparsity.
+      /// The communicator of the network's sums: the scene's when distributed, else
+      /// this rank alone (a replicated network).
+      MPI_Comm
+      network_communicator() const;
+      /// The DoF partition (owned and ghost DoFs), the vectors and the sparsity of the
+      /// Trilinos matrix.
       void
-      partition();
-      /// Sum a replicated vector's rank contributions (the same bits on every rank).
-      void
-      sum_over_ranks(Vector &x) const;
-      /// Every facet's converged spring state from its owner to all ranks.
-      void
-      synchronize_springs();
+      setup_parallel_system();
       /// solve_linear() on the distributed matrix.
       void
       solve_distributed(Vector &x);
@@ -282,29 +318,39 @@ namespace hysteron
       /// @p renew (renew_factors()).
       void
       solve_iterative(Vector &x, bool renew);
-      /// solve_distributed() with `Distributed direct solver = UMFPACK`: the matrix gathered
-      /// on rank 0 and factorized there (SparseLU), the solution sent to every rank.
+      /// solve_distributed() with `Distributed direct solver = UMFPACK`: the matrix and the
+      /// right-hand side gathered on rank 0 and solved there (SparseLU), the solution sent back.
       void
       solve_gathered(Vector &x, bool renew);
       /// Add a local matrix and vector through the constraints to the system of this rank.
       void
-      add_local(const dealii::FullMatrix<double>                     &K,
-                const dealii::Vector<double>                         &r,
-                const std::vector<dealii::types::global_dof_index> &dofs,
-                bool                                                 with_matrix);
-      /// The facet whose fracture ratio R is largest if above 1, else -1.
-      int
+      add_local(const dealii::FullMatrix<double> &K,
+                const dealii::Vector<double>     &r,
+                const std::vector<dof_index>     &dofs,
+                bool                              with_matrix);
+      /// A facet to break: the largest fracture ratio R > 1 over the network.
+      struct Break
+      {
+        double        R     = 0;
+        long long     facet = -1; ///< global facet number, -1: none
+        unsigned int  owner = 0;  ///< its rank
+        int           local = -1; ///< on its owner: the local facet
+      };
+      Break
       facet_to_break() const;
+      /// The fracture ratio R and the stresses s_n, s_t of facet @p e at its trial forces.
+      std::array<double, 3>
+      fracture_ratio(unsigned int e) const;
       void
       external_forces(const double t, Vector &f) const;
-      /// The increment of a prescribed DoF of @p set from t0 to t1 (Dirichlet conditions).
+      /// The increment of prescribed local DoF @p dof of @p set from t0 to t1.
       double
       prescribed_increment(const Dirichlet &set, const unsigned int dof, const double t0, const double t1) const;
       /// The velocity of a prescribed DoF of @p set at @p t (exact for velocities and rigid
       /// bodies, a central difference of a prescribed displacement).
       double
       prescribed_velocity(const Dirichlet &set, const unsigned int dof, const double t) const;
-      /// The cell's mass matrix about its nucleus (eq. 3.12), DoFs (u, v, theta).
+      /// The mass matrix of owned cell @p c about its nucleus (eq. 3.12 and its 3D form).
       void
       cell_mass_matrix(const unsigned int c, dealii::FullMatrix<double> &M) const;
       /// Dynamic analyses: velocities, kinetic energy.
@@ -323,15 +369,11 @@ namespace hysteron
       {
         return std::max({last_force_level, 1e-3 * force_scale, 1e-6 * predictor_level});
       }
-      /// The fracture.csv row of a break of @p facet at time @p t (its trial forces) and
-      /// what it separated.
-      std::vector<double>
-      break_row(const unsigned int facet, const double t, const Separation &separated) const;
       /// H1 of spring @p i of facet @p e for output; 0 for linear or broken springs.
       double
       h1(const unsigned int e, const unsigned int i) const
       {
-        const Springs &sp = springs[e];
+        const Springs<dim> &sp = springs[e];
         return sp.hysteretic && !sp.broken ? spring_law->h1(e, i, sp.state.data()) : 0.0;
       }
       /// The cell and facet of every probe point (a point outside the bodies is refused).
@@ -341,9 +383,12 @@ namespace hysteron
       open_tables();
       void
       write_spring_table() const;
-      /// The probe / average values of cell @p c and facet @p e (-1: none) into @p out.
+      /// The probe values of local cell @p c (-1: none) at @p x and facet @p e (-1: none)
+      /// into @p out (the cell's columns, then the facet's; zeros where none).
       void
-      point_values(const unsigned int c, const int e, const dealii::Point<2> &x, double *out) const;
+      point_values(const int c, const int e, const dealii::Point<dim> &x, double *out) const;
+      /// The number of cell columns of point_columns().
+      static constexpr unsigned int n_cell_columns = 3 * dim + 2 * (n_dofs - dim);
 
       // Analysis = variable order (variable_order.cc): the DAE in (u, v, s) and IDA.
       class VariableOrder;
@@ -354,8 +399,7 @@ namespace hysteron
       /// Integrate from 0 to the end time, reporting the output times k @p output_interval
       /// to @p step_finished (the driver writes tables and fields there); returns the end time.
       double
-      integrate_variable_order(const double output_interval,
-                               const std::function<void(double)> &step_finished);
+      integrate_variable_order(const double output_interval, const std::function<void(double)> &step_finished);
 
       // Output.
       std::vector<std::string>
@@ -365,58 +409,85 @@ namespace hysteron
       void
       write_vtu(std::ostream &out) const;
 
-      const Scene<2>              &scene;
-      const Methods::Interface<2> &method;
+      // Local numbering.
+      /// The global number of local DoF @p i.
+      dof_index
+      global_dof(const unsigned int i) const
+      {
+        return n_dofs * cell_block[i / n_dofs] + i % n_dofs;
+      }
+      /// The global DoFs of facet @p e's cells (a's, then b's).
+      void
+      facet_dofs(const unsigned int e, std::vector<dof_index> &dofs) const;
+      /// The local DoFs of facet @p e's cells (a's, then b's).
+      std::array<unsigned int, 2 * n_dofs>
+      facet_local_dofs(const unsigned int e) const;
+
+      const Scene<dim>              &scene;
+      const Methods::Interface<dim> &method;
 
       // Parameters.
-      Spacing<2>                       spacing; ///< `Minimum distance` d(x), sampled by build_network()
-      double                        d_m = 0; ///< the constant d_m, or the smallest d of a function
-      bool                          points_on_boundary = true;
-      std::vector<dealii::Point<2>> extra_points;
-      double                        boundary_h   = 0; ///< 0 until build_network(): d_m / 4
-      double                        shear_ratio  = 0;
-      double                        moment_yield = 0.25;
-      std::string                   spring_law_name;
-      std::unique_ptr<SpringLaw<2>>    spring_law; ///< `RBSN/Spring law`
-      Analysis                      analysis     = Analysis::quasi_static;
-      double                        time_step    = 0;
-      unsigned int                  n_increments = 100;
-      NewtonParameters              newton;
-      ImplicitDynamicsParameters    dynamics;
-      FractureParameters            fracture;
-      VariableOrderParameters       variable_order;
-      bool                          spring_table = false;
-      double                        reuse_tolerance = 0; ///< `Tangent reuse tolerance`
-      bool                          incremental_assembly = true; ///< `Incremental assembly`
-      std::string                   distributed_solver;  ///< `Distributed direct solver`
-      std::string                   linear_solver;       ///< `Linear solver`: direct, cg, gmres
-      double                        solver_tolerance = 1e-10;
-      unsigned int                  solver_max_iterations = 1000;
-      unsigned long                 n_linear_iterations = 0;
+      Spacing<dim>                    spacing; ///< `Minimum distance` d(x), sampled by build_network()
+      double                          d_m = 0; ///< the constant d_m, or the smallest d of a function
+      bool                            points_on_boundary = true;
+      std::vector<dealii::Point<dim>> extra_points;
+      double                          boundary_h   = 0; ///< 0 until build_network(): d_m / 4
+      double                          shear_ratio  = 0;
+      double                          moment_yield = 0.25;
+      std::string                     spring_law_name;
+      std::unique_ptr<SpringLaw<dim>> spring_law; ///< `RBSN/Spring law`
+      Analysis                        analysis     = Analysis::quasi_static;
+      double                          time_step    = 0;
+      unsigned int                    n_increments = 100;
+      NewtonParameters                newton;
+      ImplicitDynamicsParameters      dynamics;
+      FractureParameters              fracture;
+      VariableOrderParameters         variable_order;
+      bool                            spring_table = false;
+      double                          reuse_tolerance = 0; ///< `Tangent reuse tolerance`
+      bool                            incremental_assembly = true; ///< `Incremental assembly`
+      std::string                     distributed_solver;  ///< `Distributed direct solver`
+      std::string                     linear_solver;       ///< `Linear solver`: direct, cg, gmres
+      double                          solver_tolerance = 1e-10;
+      unsigned int                    solver_max_iterations = 1000;
+      unsigned long                   n_linear_iterations = 0;
 
-      // The network: cells (rigid bodies), facets (springs), bodies.
-      Tessellation<2>                          network;
-      std::vector<unsigned int>             cell_body;
-      std::vector<double>                   cell_mass, cell_inertia; ///< about the nucleus
-      std::vector<dealii::Tensor<1, 2>>     cell_offset;            ///< centroid - nucleus
-      std::vector<Springs>                  springs;
-      std::vector<const Geometry::Region<2> *> body_shapes;
-      std::vector<unsigned int>             mesh_body; ///< shape index -> scene body
-      double                                scale = 1;
-      bool                                  consistent_tangent = true;
+      // The whole network (every rank): the nuclei and the rank of every cell.
+      std::vector<dealii::Point<dim>> nuclei;
+      std::vector<unsigned int>       cell_part;
+      std::vector<dealii::Point<dim>> nuclei_box; ///< the lower and upper corner of the nuclei
+      unsigned long                   n_global_facets = 0;
 
-      // Linear algebra: 3 DoFs (u, v, theta) per cell.
-      dealii::SparsityPattern           pattern;
-      dealii::SparseMatrix<double>      matrix;
-      std::unique_ptr<SparseLU>         direct; ///< UMFPACK, the symbolic analysis kept
+      // This rank's network: its cells (rigid bodies, the owned ones first), facets
+      // (springs) and bodies. network.cells holds the owned cells' geometry,
+      // network.facets the owned facets (a, b: local cells).
+      Tessellation<dim>                          network;
+      unsigned int                               n_owned_cells = 0;
+      std::vector<unsigned int>                  cell_id;    ///< global number of every local cell
+      std::vector<dof_index>                     cell_block; ///< its DoFs are n_dofs block + k
+      std::vector<unsigned long>                 facet_id;   ///< global number of every owned facet
+      std::vector<unsigned int>                  cell_body;  ///< of every local cell
+      std::vector<double>                        cell_mass;  ///< of the owned cells
+      std::vector<dealii::Tensor<1, dim>>        cell_offset; ///< centroid - nucleus
+      /// The inertia about the nucleus per owned cell: 2D the polar moment (in [0][0]),
+      /// 3D the tensor J = rho (tr(S) I - S), S the second moment about the nucleus.
+      std::vector<dealii::SymmetricTensor<2, dim>> cell_inertia;
+      std::vector<Springs<dim>>                  springs;
+      std::vector<const Geometry::Region<dim> *> body_shapes;
+      std::vector<unsigned int>                  mesh_body; ///< shape index -> scene body
+      double                                     scale = 1;
+      bool                                       consistent_tangent = true;
 
-      // MPI: ranks, the owner of every cell, the facets this rank evaluates, its DoFs.
-      unsigned int                               n_ranks = 1, rank = 0;
-      std::vector<unsigned int>                  cell_owner;
-      std::vector<bool>                          owned_facet;
-      std::vector<unsigned int>                  owned_facets;
-      dealii::IndexSet                           owned_dofs;
-      dealii::TrilinosWrappers::SparseMatrix     parallel_matrix, factored_parallel;
+      // Linear algebra: n_dofs DoFs per cell.
+      dealii::SparsityPattern      pattern;
+      dealii::SparseMatrix<double> matrix;
+      std::unique_ptr<SparseLU>    direct; ///< UMFPACK, the symbolic analysis kept
+
+      // MPI: the parts of the network (ranks; 1 for a replicated network), this rank's DoFs.
+      unsigned int                                            n_parts = 1, part = 0;
+      dealii::IndexSet                                        owned_dofs, relevant_dofs;
+      std::shared_ptr<const dealii::Utilities::MPI::Partitioner> partitioner;
+      dealii::TrilinosWrappers::SparseMatrix                  parallel_matrix, factored_parallel;
       dealii::SolverControl                                   parallel_control{1, 0};
       std::unique_ptr<dealii::TrilinosWrappers::SolverDirect> parallel_direct; ///< Amesos
       /// cg / gmres: ML algebraic multigrid with the cells' rigid-body modes.
@@ -434,24 +505,25 @@ namespace hysteron
       /// step (else the next assembly starts from zero), as does the assembly after
       /// max_incremental_updates updates. A checkpoint holds this state and the matrix, so
       /// that a resumed run takes the same steps bit for bit.
-      std::vector<SpringLaw<2>::Matrix> assembled_tangent;
-      std::vector<bool>              facet_in_matrix;
-      bool                           matrix_current = false;
-      double                         matrix_dt      = 0;
-      unsigned int                   incremental_updates = 0;
-      static constexpr unsigned int  max_incremental_updates = 100;
-      unsigned long                  n_matrix_assemblies = 0, n_full_assemblies = 0;
-      unsigned long                  n_facet_evaluations = 0, n_facet_updates = 0;
+      std::vector<SpringMatrix>     assembled_tangent;
+      std::vector<bool>             facet_in_matrix;
+      bool                          matrix_current = false;
+      double                        matrix_dt      = 0;
+      unsigned int                  incremental_updates = 0;
+      static constexpr unsigned int max_incremental_updates = 100;
+      unsigned long                 n_matrix_assemblies = 0, n_full_assemblies = 0;
+      unsigned long                 n_facet_evaluations = 0, n_facet_updates = 0;
       /// f_int, f_ext and inertia: the last evaluation (an iterate); f_ext_old and
       /// reaction_old (f_int + inertia - f_ext): the converged state, which the output reads.
+      /// u, u_trial, v and a keep their ghost values up to date.
       Vector u, u_trial, v, a, rhs, f_int, f_ext, f_ext_old, inertia, reaction_old;
       std::vector<Dirichlet> dirichlet;
-      std::vector<int>       dof_set; ///< the Dirichlet set of each DoF, -1 if free
+      std::vector<int>       dof_set; ///< the Dirichlet set of each local DoF, -1 if free
       std::vector<LoadSet>   load_sets;
       double                 force_scale = 0, last_force_level = 0, predictor_level = 0;
 
       // Bookkeeping.
-      PointData::Tables<2>                 tables;
+      PointData::Tables<dim>               tables;
       /// newton.csv (Newton's iterations), ida.csv with variable order (the integrator's statistics)
       std::unique_ptr<Output::TimeTable>   newton_table, fracture_table;
       /// The load increments (cuts and recovery).
@@ -463,15 +535,20 @@ namespace hysteron
       unsigned int  n_cuts = 0;
       std::string   spring_failure;
       std::string   solver_failure; ///< a singular tangent in the last attempt
-      std::vector<int>              probe_cell, probe_facet;
-      /// `Output/History sets`: the cells of each set (nucleus on its box faces or in its region).
+      /// Per probe: its global cell and facet (-1: none) and, on their owners, the local ones.
+      std::vector<long long>         probe_global_cell, probe_global_facet;
+      std::vector<int>               probe_cell, probe_facet;
+      /// `Output/History sets`: the owned cells of each set (nucleus on its box faces or in
+      /// its region), and the set's number of cells.
       std::vector<std::vector<unsigned int>> history_cells;
+      std::vector<unsigned long>             history_size;
 
-      // Fragments (supports.cc): the part of every cell over the intact facets, and the
-      // cells a static analysis has released (their fragment is not held).
-      std::vector<unsigned int> fragment;
-      std::vector<bool>         released;
-      std::vector<unsigned int> lone_cells; ///< fragments of one cell (no intact facet)
+      // Fragments (supports.cc): the part of every local cell over the intact facets, and
+      // the cells a static analysis has released (their fragment is not held).
+      std::vector<unsigned int>  fragment;
+      std::vector<unsigned long> fragment_size; ///< cells of every fragment
+      std::vector<bool>          released;
+      std::vector<unsigned int> lone_cells; ///< local cells in fragments of one cell
       unsigned int              n_fragments = 0;
       unsigned long             n_released  = 0;
     };

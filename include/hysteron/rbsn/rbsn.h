@@ -10,21 +10,22 @@ namespace hysteron
 {
   namespace RBSN
   {
+    template <int dim>
     class Model;
 
     /**
      * The Rigid-Body-Spring Network (`set Method = rbsn`, dissertation chapter
-     * 3; doc/rbsn.md): the scene's bodies (2D) are cut into Voronoi cells around
-     * seeded random points; every cell is a rigid body with the DoFs u, v, theta
-     * of its nucleus, and every common facet of two cells carries three
-     * zero-length springs (normal, tangential, rotational) with the Voronoi
-     * scaled stiffnesses of eq. 3.9 and uniaxial Bouc-Wen laws (eq. 3.32-3.36).
+     * 3; doc/rbsn.md, doc/rbsn3d.md): the scene's bodies are cut into Voronoi cells
+     * around seeded random points; every cell is a rigid body with the DoFs of its
+     * nucleus (2D: u, v, theta; 3D: three translations and three rotations), and
+     * every common facet of two cells carries zero-length springs (2D: normal,
+     * tangential, rotational; 3D: normal, two shear, two bending, torsion) with the
+     * Voronoi scaled stiffnesses of eq. 3.9 and Bouc-Wen laws (eq. 3.32-3.42).
      * Static, quasi-static (Newton) and dynamic (Newmark / HHT with Newton, or
      * SUNDIALS' variable-order IDA) analyses, and brittle fracture of the facets
      * (Mohr-Coulomb with a tension cut-off, eq. 3.49-3.51).
      *
-     * The work is done by Model (two-dimensional); in a 3D scene the method is
-     * refused.
+     * The work is done by Model<dim>, distributed over the MPI ranks.
      */
     template <int dim>
     class Solver : public Run::SteppingMethod<dim>
@@ -82,7 +83,7 @@ namespace hysteron
       load(CheckpointReader &in) override;
 
     private:
-      std::unique_ptr<Model> model;
+      std::unique_ptr<Model<dim>> model;
     };
   } // namespace RBSN
 } // namespace hysteron
