@@ -710,7 +710,7 @@ TYPED_TEST(BoucWenInteractionN, EachComponentAloneIsTheUniaxialLaw)
               double T1 = 0;
               coupled.update(dd, F, z.data(), &T);
               uniaxial.update(dd[i], F1, z1, &T1);
-              worst         = std::max({worst, std::abs(F[i] - F1) / F_y[i], std::abs(z[i] - z1[0]) / z_y[i]});
+              worst = std::max({worst, std::abs(F[i] - F1) / F_y[i], std::abs(z[i] - z1[0]) / z_y[i]});
               worst_tangent = std::max(worst_tangent, std::abs(T[i][i] - T1) / k[i]);
               for (unsigned int m = 0; m < N; ++m)
                 if (m != i)
@@ -722,7 +722,8 @@ TYPED_TEST(BoucWenInteractionN, EachComponentAloneIsTheUniaxialLaw)
                   }
             }
           EXPECT_LT(worst, 1e-10) << name(integrator) << ", component " << i << ", beta " << beta;
-          EXPECT_LT(worst_tangent, 1e-8) << name(integrator) << ", component " << i << ", beta " << beta;
+          EXPECT_LT(worst_tangent, 1e-8)
+            << name(integrator) << ", component " << i << ", beta " << beta;
         }
   std::cout << "  N = " << N << ": max difference to the uniaxial law " << worst
             << " (F / F_y, z / z_y), tangent " << worst_tangent << " k" << std::endl;
@@ -837,7 +838,8 @@ TYPED_TEST(BoucWenInteractionN, RandomCyclicPathStaysInsideAndDissipates)
                 work += step_work;
                 min_step_dissipation =
                   std::min(min_step_dissipation,
-                           step_work - (this->stored_energy(a, path[j], z) - this->stored_energy(a, path[j - 1], z0)));
+                           step_work - (this->stored_energy(a, path[j], z) -
+                                        this->stored_energy(a, path[j - 1], z0)));
                 phi_max = std::max(phi_max, this->phi(z));
               }
             double scale = 0; // the energy of the yield point, sum_i F_y,i z_y,i
@@ -846,8 +848,9 @@ TYPED_TEST(BoucWenInteractionN, RandomCyclicPathStaysInsideAndDissipates)
             const double dissipation = (work - (this->stored_energy(a, path.back(), z) -
                                                 this->stored_energy(a, path.front(), Vector{}))) /
                                        scale;
-            const std::string where = std::string(name(integrator)) + ", beta " + std::to_string(beta) +
-                                      ", " + std::to_string(steps) + " steps, seed " + std::to_string(seed);
+            const std::string where = std::string(name(integrator)) + ", beta " +
+                                      std::to_string(beta) + ", " + std::to_string(steps) +
+                                      " steps, seed " + std::to_string(seed);
             EXPECT_GT(phi_max, 0.99 * phi_s) << where; // the path does yield
             if (integrator != BoucWenIntegrator::forward_euler)
               {
@@ -889,7 +892,8 @@ TYPED_TEST(BoucWenInteractionN, BackwardEulerTangentMatchesFiniteDifferences)
     for (const double beta : {0.5, 0.75})
       for (unsigned int sample = 0; sample < 12; ++sample)
         {
-          const BoucWenParameters p = parameters(n, BoucWenIntegrator::backward_euler, 1e-13, 0.03, beta);
+          const BoucWenParameters p =
+            parameters(n, BoucWenIntegrator::backward_euler, 1e-13, 0.03, beta);
           const typename TestFixture::Law law(p, k, F_y);
           // w0 in the ball (radius up to 0.98), Delta d of length 0.01 to 3.
           Vector w0, d;
@@ -901,7 +905,8 @@ TYPED_TEST(BoucWenInteractionN, BackwardEulerTangentMatchesFiniteDifferences)
               r0 += w0[i] * w0[i];
               rd += d[i] * d[i];
             }
-          const double radius = 0.98 * std::cbrt(uniform(random)), length = 0.01 * std::pow(300, uniform(random));
+          const double radius = 0.98 * std::cbrt(uniform(random)),
+                       length = 0.01 * std::pow(300, uniform(random));
           for (unsigned int i = 0; i < N; ++i)
             {
               w0[i] *= radius / std::sqrt(r0);
@@ -1077,7 +1082,8 @@ TYPED_TEST(BoucWenInteractionN, UnsupportedParametersAndFailures)
         {
           Vector z{}, F{}, dd{};
           z[0]  = 0.5 * this->z_y[0];
-          dd[i] = i % 2 ? std::numeric_limits<double>::infinity() : std::numeric_limits<double>::quiet_NaN();
+          dd[i] = i % 2 ? std::numeric_limits<double>::infinity() :
+                          std::numeric_limits<double>::quiet_NaN();
           try
             {
               law.update(dd, F, z.data(), nullptr);

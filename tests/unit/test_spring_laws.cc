@@ -103,7 +103,7 @@ namespace
         {
           const double b = 0.1 * scale, h = 0.05 * scale, L = 0.08 * scale, A = b * h;
           const double I_1 = b * h * h * h / 12, I_2 = h * b * b * b / 12, J = I_1 + I_2;
-          springs.k              = {{E * A / L, G * A / L, G * A / L, E * I_1 / L, E * I_2 / L, G * J / L}};
+          springs.k = {{E * A / L, G * A / L, G * A / L, E * I_1 / L, E * I_2 / L, G * J / L}};
           springs.area           = A;
           springs.second_moments = {{I_1, I_2}};
           springs.length         = std::sqrt(A);
@@ -326,9 +326,11 @@ TYPED_TEST(SpringLawsIn, VariableOrderAndUniaxialSpringsAgree)
               }
             ASSERT_NE(spring.law, nullptr) << c.name << ", " << RBSN::spring_name<dim>(i);
             EXPECT_EQ(spring.law->stiffness(), this->facets[e].springs.k[i]) << c.name;
-            EXPECT_NEAR(spring.law->yield_value(), this->facets[e].yield[i], 1e-14 * this->facets[e].yield[i])
+            const double yield = this->facets[e].yield[i];
+            EXPECT_NEAR(spring.law->yield_value(), yield, 1e-14 * yield)
               << c.name << ", " << RBSN::spring_name<dim>(i);
-            EXPECT_LE(spring.offset + spring.law->n_state_variables(), c.law->n_state_variables()) << c.name;
+            EXPECT_LE(spring.offset + spring.law->n_state_variables(), c.law->n_state_variables())
+              << c.name;
             offsets.insert(spring.offset);
           }
         if (supported)

@@ -112,7 +112,12 @@ namespace hysteron
      *   the branch of H2 is decided by the elastic trial: w_tr . Delta d > 0: loading,
      *   H2 = beta + gamma, g(0) < 0 and g -> +infinity, a root in mu > 0 always exists;
      *   w_tr . Delta d < 0: H2 = beta - gamma (0 for beta = gamma: exactly elastic),
-     *   root in (-1/max c_i, 0). The scalar equation is solved by a bracketed Newton
+     *   root in (-1/max c_i, 0). A loading step does not leave the ball Phi <= Phi_s: at
+     *   a root, w . w = w . w_tr - mu w^T C w = w . w0 + (w . Delta d)(1 - H1 H2), and
+     *   Phi > Phi_s (H1 H2 > 1) with w . Delta d > 0 would give w . w < w . w0 <= Phi Phi0,
+     *   i.e. Phi < Phi0 <= Phi_s, a contradiction (an unloading step likewise ends with
+     *   Phi <= Phi0 wherever H1 (beta - gamma) <= 1; for beta = gamma it is elastic with
+     *   w . w = w . w0 + w . Delta d < w . w0). The scalar equation is solved by a bracketed Newton
      *   iteration with the analytic derivative (bisection where Newton leaves the
      *   bracket); no bracket or no convergence is a RuntimeError. The consistent N x N
      *   tangent follows from the implicit function theorem on the full residual,
