@@ -3,8 +3,11 @@
 #include <hysteron/material/bouc_wen_interaction.h>
 #include <hysteron/material/integer_power.h>
 
+#include "bouc_wen_kernel_helpers.h"
+
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -15,44 +18,100 @@ namespace hysteron
   {
     namespace
     {
-      using Vector = BoucWenInteraction::Vector;
+      // The sums run from the first term on, left to right: for N = 3 they are the
+      // expressions x[0] * y[0] + x[1] * y[1] + x[2] * y[2] of the three-component law, to
+      // the bit.
 
+      template <std::size_t N>
       double
-      dot(const Vector &x, const Vector &y)
+      dot(const std::array<double, N> &x, const std::array<double, N> &y)
       {
-        return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+        double s = x[0] * y[0];
+        for (std::size_t i = 1; i < N; ++i)
+          s += x[i] * y[i];
+        return s;
       }
 
       /// x^T C x for the diagonal C.
+      template <std::size_t N>
       double
-      weighted_square(const Vector &c, const Vector &x)
+      weighted_square(const std::array<double, N> &c, const std::array<double, N> &x)
       {
-        return c[0] * x[0] * x[0] + c[1] * x[1] * x[1] + c[2] * x[2] * x[2];
+        double s = c[0] * x[0] * x[0];
+        for (std::size_t i = 1; i < N; ++i)
+          s += c[i] * x[i] * x[i];
+        return s;
       }
 
-      BoucWenInteraction::Matrix
+      template <int N>
+      dealii::Tensor<2, N>
       identity()
       {
-        BoucWenInteraction::Matrix I;
-        for (unsigned int i = 0; i < 3; ++i)
+        dealii::Tensor<2, N> I;
+        for (unsigned int i = 0; i < N; ++i)
           I[i][i] = 1;
         return I;
+      }
+
+      /**
+       * X = J^(-1) B for N x N matrices, or false if J is singular. N = 3: deal.II's
+       * closed-form inverse (cofactors over the determinant), the solve of the
+       * three-component law, kept so that 2D results do not change; otherwise LU with
+       * partial pivoting (BoucWenKernels::lu_factorize()), one solve per column of B.
+       */
+      template <int N>
+      bool
+      solve(const dealii::Tensor<2, N> &J, const dealii::Tensor<2, N> &B, dealii::Tensor<2, N> &X)
+      {
+        if constexpr (N == 3)
+          {
+            if (!(std::abs(dealii::determinant(J)) > 0))
+              return false;
+            X = dealii::invert(J) * B;
+            return true;
+          }
+        else
+          {
+            std::array<double, N * N>    LU;
+            std::array<unsigned int, N> pivot;
+            for (unsigned int i = 0; i < N; ++i)
+              for (unsigned int j = 0; j < N; ++j)
+                LU[i * N + j] = J[i][j];
+            if (!BoucWenKernels::lu_factorize<N>(LU, pivot))
+              return false;
+            for (unsigned int j = 0; j < N; ++j)
+              {
+                double column[N];
+                for (unsigned int i = 0; i < N; ++i)
+                  column[i] = B[i][j];
+                BoucWenKernels::lu_solve<N>(LU, pivot, column);
+                for (unsigned int i = 0; i < N; ++i)
+                  {
+                    if (!std::isfinite(column[i]))
+                      return false;
+                    X[i][j] = column[i];
+                  }
+              }
+            return true;
+          }
       }
     } // namespace
 
 
 
-    BoucWenInteraction::BoucWenInteraction(const BoucWenParameters &parameters,
-                                           const Vector            &stiffness,
-                                           const Vector            &yield_values)
+    template <unsigned int N>
+    BoucWenInteraction<N>::BoucWenInteraction(const BoucWenParameters &parameters,
+                                              const Vector            &stiffness,
+                                              const Vector            &yield_values)
     {
       reinit(parameters, stiffness, yield_values);
     }
 
 
 
+    template <unsigned int N>
     std::string
-    BoucWenInteraction::unsupported(const BoucWenParameters &parameters)
+    BoucWenInteraction<N>::unsupported(const BoucWenParameters &parameters)
     {
       if (parameters.degradation())
         return "the coupled spring law has no stiffness degradation or strength deterioration "
@@ -64,15 +123,16 @@ namespace hysteron
 
 
 
+    template <unsigned int N>
     void
-    BoucWenInteraction::reinit(const BoucWenParameters &parameters,
-                               const Vector            &stiffness,
-                               const Vector            &yield_values)
+    BoucWenInteraction<N>::reinit(const BoucWenParameters &parameters,
+                                  const Vector            &stiffness,
+                                  const Vector            &yield_values)
     {
       const std::string why = unsupported(parameters);
       if (!why.empty())
         throw std::invalid_argument("BoucWenInteraction: " + why);
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < N; ++i)
         if (!(stiffness[i] > 0) || !(yield_values[i] > 0) || !std::isfinite(stiffness[i]) ||
             !std::isfinite(yield_values[i]))
           throw std::invalid_argument("BoucWenInteraction: the stiffnesses and the yield values "
@@ -88,21 +148,22 @@ namespace hysteron
       phi_saturation = std::pow(beta + gamma, -1 / n);
       // c_i = 1 / (F^h_y,i z_y,i) = 1 / ((1 - a) k_i z_y,i^2), relative to the largest.
       double c_max = 0;
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < N; ++i)
         {
           z_y[i]     = yield_values[i] / k[i];
           inv_z_y[i] = 1 / z_y[i];
           c[i]       = 1 / (k[i] * z_y[i] * z_y[i]);
           c_max      = std::max(c_max, c[i]);
         }
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < N; ++i)
         c[i] /= c_max;
     }
 
 
 
+    template <unsigned int N>
     double
-    BoucWenInteraction::h1_of_squared(const double phi2) const
+    BoucWenInteraction<N>::h1_of_squared(const double phi2) const
     {
       if (n_integer > 0 && n_integer % 2 == 0)
         return integer_power(phi2, n_integer / 2);
@@ -113,19 +174,21 @@ namespace hysteron
 
 
 
+    template <unsigned int N>
     double
-    BoucWenInteraction::yield_function(const double *z, const unsigned int stride) const
+    BoucWenInteraction<N>::yield_function(const double *z, const unsigned int stride) const
     {
       double phi2 = 0;
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < N; ++i)
         phi2 += (z[i * stride] * inv_z_y[i]) * (z[i * stride] * inv_z_y[i]);
       return std::sqrt(phi2);
     }
 
 
 
+    template <unsigned int N>
     double
-    BoucWenInteraction::h1(const double *z, const unsigned int stride) const
+    BoucWenInteraction<N>::h1(const double *z, const unsigned int stride) const
     {
       const double phi = yield_function(z, stride);
       return h1_of_squared(phi * phi);
@@ -133,19 +196,23 @@ namespace hysteron
 
 
 
-    Vector
-    BoucWenInteraction::forces(const Vector &delta, const double *z, const unsigned int stride) const
+    template <unsigned int N>
+    typename BoucWenInteraction<N>::Vector
+    BoucWenInteraction<N>::forces(const Vector      &delta,
+                                  const double      *z,
+                                  const unsigned int stride) const
     {
       Vector F;
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < N; ++i)
         F[i] = a * k[i] * delta[i] + (1 - a) * k[i] * z[i * stride];
       return F;
     }
 
 
 
-    Vector
-    BoucWenInteraction::rates_w(const Vector &w, const Vector &d) const
+    template <unsigned int N>
+    typename BoucWenInteraction<N>::Vector
+    BoucWenInteraction<N>::rates_w(const Vector &w, const Vector &d) const
     {
       // w' = d - H1 H2 (C w)(w . d) / (w^T C w)
       const double phi2 = dot(w, w);
@@ -155,15 +222,16 @@ namespace hysteron
       const double H2 = P > 0 ? beta + gamma : (P < 0 ? beta - gamma : beta);
       const double f  = h1_of_squared(phi2) * H2 * P / weighted_square(c, w);
       Vector       r;
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < N; ++i)
         r[i] = d[i] - f * c[i] * w[i];
       return r;
     }
 
 
 
-    BoucWenInteraction::Matrix
-    BoucWenInteraction::tangent_w(const Vector &w, const Vector &d) const
+    template <unsigned int N>
+    typename BoucWenInteraction<N>::Matrix
+    BoucWenInteraction<N>::tangent_w(const Vector &w, const Vector &d) const
     {
       // I - H1 H2 (C w) w^T / (w^T C w)
       Matrix       T;
@@ -171,59 +239,62 @@ namespace hysteron
       const double P    = dot(w, d);
       const double H2   = P > 0 ? beta + gamma : (P < 0 ? beta - gamma : beta);
       const double f    = phi2 > 0 ? h1_of_squared(phi2) * H2 / weighted_square(c, w) : 0.0;
-      for (unsigned int i = 0; i < 3; ++i)
-        for (unsigned int j = 0; j < 3; ++j)
+      for (unsigned int i = 0; i < N; ++i)
+        for (unsigned int j = 0; j < N; ++j)
           T[i][j] = (i == j ? 1.0 : 0.0) - f * c[i] * w[i] * w[j];
       return T;
     }
 
 
 
+    template <unsigned int N>
     void
-    BoucWenInteraction::rates(const double      *z,
-                              const Vector      &delta_rate,
-                              double            *z_rate,
-                              const unsigned int stride) const
+    BoucWenInteraction<N>::rates(const double      *z,
+                                 const Vector      &delta_rate,
+                                 double            *z_rate,
+                                 const unsigned int stride) const
     {
       Vector w, d;
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < N; ++i)
         {
           w[i] = z[i * stride] * inv_z_y[i];
           d[i] = delta_rate[i] * inv_z_y[i];
         }
       const Vector f = rates_w(w, d);
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < N; ++i)
         z_rate[i * stride] = f[i] * z_y[i];
     }
 
 
 
-    BoucWenInteraction::Matrix
-    BoucWenInteraction::continuum_tangent(const double      *z,
-                                          const Vector      &delta_rate,
-                                          const unsigned int stride) const
+    template <unsigned int N>
+    typename BoucWenInteraction<N>::Matrix
+    BoucWenInteraction<N>::continuum_tangent(const double      *z,
+                                             const Vector      &delta_rate,
+                                             const unsigned int stride) const
     {
       Vector w, d;
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < N; ++i)
         {
           w[i] = z[i * stride] * inv_z_y[i];
           d[i] = delta_rate[i] * inv_z_y[i];
         }
       const Matrix T = tangent_w(w, d);
       Matrix       D;
-      for (unsigned int i = 0; i < 3; ++i)
-        for (unsigned int j = 0; j < 3; ++j)
+      for (unsigned int i = 0; i < N; ++i)
+        for (unsigned int j = 0; j < N; ++j)
           D[i][j] = (i == j ? a * k[i] : 0.0) + (1 - a) * k[i] * z_y[i] * T[i][j] * inv_z_y[j];
       return D;
     }
 
 
 
+    template <unsigned int N>
     unsigned int
-    BoucWenInteraction::backward_euler(Vector &w, const Vector &d, Matrix *dw_dd) const
+    BoucWenInteraction<N>::backward_euler(Vector &w, const Vector &d, Matrix *dw_dd) const
     {
       Vector w_tr;
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < N; ++i)
         w_tr[i] = w[i] + d[i];
       const double P_tr = dot(w_tr, d);
       const double s    = P_tr > 0 ? 1.0 : -1.0;
@@ -233,7 +304,7 @@ namespace hysteron
           // Exactly elastic: the flow term vanishes (w . d = 0, or H2 = 0 while unloading).
           w = w_tr;
           if (dw_dd)
-            *dw_dd = identity();
+            *dw_dd = identity<N>();
           return 0;
         }
 
@@ -249,7 +320,7 @@ namespace hysteron
         const double mu = s * nu;
         Value        v;
         Vector       dw; // dw/dmu
-        for (unsigned int i = 0; i < 3; ++i)
+        for (unsigned int i = 0; i < N; ++i)
           {
             const double f = 1 / (1 + mu * c[i]);
             v.w[i]         = w_tr[i] * f;
@@ -262,7 +333,7 @@ namespace hysteron
         const double dphi2 = 2 * dot(v.w, dw);
         const double dP    = dot(dw, d);
         double       dA    = 0;
-        for (unsigned int i = 0; i < 3; ++i)
+        for (unsigned int i = 0; i < N; ++i)
           dA += 2 * c[i] * v.w[i] * dw[i];
         const double q  = v.h1 * v.P / v.A;
         const double dq = 0.5 * n * v.h1 * dphi2 / v.phi2 * v.P / v.A +
@@ -280,7 +351,7 @@ namespace hysteron
       // The explicit estimate of the root: nu ~ H2 Phi_tr^n |w_tr . d| / (w_tr^T C w_tr).
       // (capped where Phi_tr^n overflows or the estimate is far beyond the radial return,
       // nu = (Phi_tr - 1) / min c_i, which reaches Phi <= 1).
-      const double c_min = std::min({c[0], c[1], c[2]});
+      const double c_min = *std::min_element(c.begin(), c.end());
       double       step  = H2 * v.h1 * std::abs(v.P) / v.A;
       const double cap   = (1 + std::sqrt(v.phi2)) / c_min;
       step               = std::max(std::isfinite(step) ? std::min(step, cap) : cap, tolerance);
@@ -337,8 +408,8 @@ namespace hysteron
           //   dr/dw = I + H2 (C w (x) dq/dw + q C),   dr/dd = -I + H2 C w (x) dq/dd.
           const double q = v.h1 * v.P / v.A;
           Matrix       J, R;
-          for (unsigned int i = 0; i < 3; ++i)
-            for (unsigned int j = 0; j < 3; ++j)
+          for (unsigned int i = 0; i < N; ++i)
+            for (unsigned int j = 0; j < N; ++j)
               {
                 const double dq_dw = v.h1 *
                                      (n * v.P / v.phi2 * w[j] + d[j] - 2 * v.P * c[j] * w[j] / v.A) /
@@ -347,34 +418,38 @@ namespace hysteron
                 J[i][j] = (i == j ? 1 + H2 * q * c[i] : 0.0) + H2 * c[i] * w[i] * dq_dw;
                 R[i][j] = (i == j ? -1.0 : 0.0) + H2 * c[i] * w[i] * dq_dd;
               }
-          if (!(std::abs(dealii::determinant(J)) > 0))
+          Matrix X;
+          if (!solve<N>(J, R, X))
             fail("the local Jacobian is singular", w, d);
-          *dw_dd = -(dealii::invert(J) * R);
+          *dw_dd = -X;
         }
       return iterations;
     }
 
 
 
+    template <unsigned int N>
     unsigned int
-    BoucWenInteraction::update(const Vector      &ddelta,
-                               Vector            &force,
-                               double            *z,
-                               Matrix            *tangent,
-                               const unsigned int stride) const
+    BoucWenInteraction<N>::update(const Vector      &ddelta,
+                                  Vector            &force,
+                                  double            *z,
+                                  Matrix            *tangent,
+                                  const unsigned int stride) const
     {
       Vector w0, d;
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < N; ++i)
         {
           w0[i] = z[i * stride] * inv_z_y[i];
           d[i]  = ddelta[i] * inv_z_y[i];
-          if (!std::isfinite(d[i]))
-            fail("the increment is not finite", w0, d);
         }
+      // (After the loop, so that the message shows every component.)
+      for (unsigned int i = 0; i < N; ++i)
+        if (!std::isfinite(d[i]))
+          fail("the increment is not finite", w0, d);
       Vector       w    = w0;
-      Matrix       T    = identity();
+      Matrix       T    = identity<N>();
       unsigned int work = 1;
-      if (d[0] == 0 && d[1] == 0 && d[2] == 0)
+      if (std::all_of(d.begin(), d.end(), [](const double x) { return x == 0; }))
         {
           if (tangent)
             T = tangent_w(w, d);
@@ -388,13 +463,14 @@ namespace hysteron
                 if (tangent)
                   T = tangent_w(w, d);
                 const Vector f = rates_w(w, d);
-                for (unsigned int i = 0; i < 3; ++i)
+                for (unsigned int i = 0; i < N; ++i)
                   w[i] += f[i];
                 break;
               }
             case BoucWenIntegrator::adaptive:
               {
-                const Vector inv_scale{{1 / tolerance, 1 / tolerance, 1 / tolerance}};
+                Vector inv_scale;
+                inv_scale.fill(1 / tolerance);
                 work = bogacki_shampine_32(
                   w,
                   inv_scale,
@@ -406,7 +482,7 @@ namespace hysteron
                     if (!(phi2 > 0))
                       return 0.0;
                     Vector p;
-                    for (unsigned int i = 0; i < 3; ++i)
+                    for (unsigned int i = 0; i < N; ++i)
                       p[i] = d[i] - f[i];
                     return n * std::sqrt(dot(p, p) / phi2);
                   },
@@ -415,7 +491,7 @@ namespace hysteron
                     const double phi = std::sqrt(dot(x, x));
                     if (!(phi > phi_saturation))
                       return false;
-                    for (unsigned int i = 0; i < 3; ++i)
+                    for (unsigned int i = 0; i < N; ++i)
                       x[i] *= phi_saturation / phi;
                     return true;
                   },
@@ -435,15 +511,15 @@ namespace hysteron
               break;
           }
 
-      for (unsigned int i = 0; i < 3; ++i)
+      for (unsigned int i = 0; i < N; ++i)
         {
           const double z0 = z[i * stride], z1 = w[i] * z_y[i];
           z[i * stride]   = z1;
           force[i] += a * k[i] * ddelta[i] + (1 - a) * k[i] * (z1 - z0);
         }
       if (tangent)
-        for (unsigned int i = 0; i < 3; ++i)
-          for (unsigned int j = 0; j < 3; ++j)
+        for (unsigned int i = 0; i < N; ++i)
+          for (unsigned int j = 0; j < N; ++j)
             (*tangent)[i][j] =
               (i == j ? a * k[i] : 0.0) + (1 - a) * k[i] * z_y[i] * T[i][j] * inv_z_y[j];
       return work;
@@ -451,17 +527,28 @@ namespace hysteron
 
 
 
+    template <unsigned int N>
     void
-    BoucWenInteraction::fail(const std::string &what, const Vector &w, const Vector &d) const
+    BoucWenInteraction<N>::fail(const std::string &what, const Vector &w, const Vector &d) const
     {
       std::ostringstream m;
       m << "Bouc-Wen (coupled springs, "
         << (prm.integrator == BoucWenIntegrator::forward_euler ? "forward euler" :
             prm.integrator == BoucWenIntegrator::adaptive      ? "adaptive" :
                                                                  "backward euler")
-        << "): " << what << " (z/z_y = " << w[0] << ", " << w[1] << ", " << w[2]
-        << "; increment/z_y = " << d[0] << ", " << d[1] << ", " << d[2] << ")";
+        << "): " << what << " (z/z_y = ";
+      for (unsigned int i = 0; i < N; ++i)
+        m << (i > 0 ? ", " : "") << w[i];
+      m << "; increment/z_y = ";
+      for (unsigned int i = 0; i < N; ++i)
+        m << (i > 0 ? ", " : "") << d[i];
+      m << ")";
       throw RuntimeError(m.str());
     }
+
+
+
+    template class BoucWenInteraction<3>;
+    template class BoucWenInteraction<6>;
   } // namespace Material
 } // namespace hysteron

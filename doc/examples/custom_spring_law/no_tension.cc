@@ -4,11 +4,11 @@
 // choose it with `set Spring law = no tension` in `subsection RBSN`.
 //
 // Model (a masonry-like joint): the normal spring carries compression only,
-// F_n = k_n min(delta_n, 0), the tangential and rotational springs are linear,
-// F_t = k_t delta_t, M = k_phi phi. The law works on the total deformations, which it keeps
-// as its state (the interface passes increments); it applies to every material (linear
-// elastic ones too), so every facet is the law's. The tangent is diagonal: k_n in
-// compression, 0 in tension.
+// F_n = k_n min(delta_n, 0), the other springs are linear, F_i = k_i delta_i (2D: the
+// tangential and rotational springs; 3D: the two shear, two bending and the torsion springs).
+// The law works on the total deformations, which it keeps as its state (the interface passes
+// increments); it applies to every material (linear elastic ones too), so every facet is the
+// law's. The tangent is diagonal: k_n in compression, 0 in tension.
 #include <hysteron/rbsn/spring_law.h>
 
 #include <algorithm>
@@ -29,7 +29,8 @@ namespace custom
     using typename SpringLaw<dim>::Matrix;
     static constexpr unsigned int n = SpringLaw<dim>::n;
 
-    /// The total deformations (2D: delta_n, delta_t, phi).
+    /// The total deformations (2D: delta_n, delta_t, phi; 3D: delta_n, delta_1, delta_2,
+    /// phi_1, phi_2, phi_n).
     unsigned int
     n_state_variables() const override
     {
@@ -104,4 +105,4 @@ namespace custom
 HYSTERON_REGISTER_SPRING_LAW(custom::NoTension,
                              "no tension",
                              "example plugin: the normal spring carries compression only, "
-                             "F_n = k_n min(delta_n, 0); linear tangential and rotational springs")
+                             "F_n = k_n min(delta_n, 0); the other springs linear")

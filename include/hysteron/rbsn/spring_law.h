@@ -71,8 +71,8 @@ namespace hysteron
        * f (sigma_y / sqrt(3)) A sqrt(12 J / A), J = I_1 + I_2, with f = `Moment yield
        * factor`. For a rectangular section b x h bent about its b side, sqrt(12 I / A) = h
        * and f = 1/4 gives the plastic moment sigma_y b h^2 / 4; in 2D this is
-       * f sigma_y t l^2. The torque with f = 1/4 is within 8 % of the plastic torque of a
-       * square and of a circular section (doc/rbsn3d.md).
+       * f sigma_y t l^2. With f = 1/4 the torque is 1.061 times the plastic torque of a square
+       * and 0.919 times that of a circle (derivation: doc/rbsn_coupled_springs.md).
        */
       std::array<double, n_springs<dim>>
       yield_values(const double sigma_y) const

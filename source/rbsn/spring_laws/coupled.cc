@@ -2,6 +2,8 @@
 #include <hysteron/material/bouc_wen_parameters.h>
 #include <hysteron/rbsn/spring_law.h>
 
+#include <string>
+#include <type_traits>
 
 namespace hysteron
 {
@@ -10,11 +12,14 @@ namespace hysteron
     namespace
     {
       /**
-       * One Bouc-Wen law for the three springs of a facet (eq. 3.38-3.42,
-       * doc/rbsn_coupled_springs.md): the yield criterion
-       * Phi^2 = (F^h_n / F^h_y,n)^2 + (F^h_t / F^h_y,t)^2 + (M^h / M^h_y)^2 <= 1 in the
-       * hysteretic forces F^h_i = (1 - a) k_i z_i with associated flow, and a full
-       * 3 x 3 tangent D_t. The state is z = (z_n, z_t, z_phi).
+       * One Bouc-Wen law for all springs of a facet (eq. 3.38-3.42,
+       * doc/rbsn_coupled_springs.md), Material::BoucWenInteraction<n> with n = 3 in 2D
+       * and 6 in 3D: the yield criterion Phi^2 = sum_i (F^h_i / F^h_y,i)^2 <= 1 in the
+       * hysteretic forces F^h_i = (1 - a) k_i z_i (2D: F_n, F_t, M; 3D: N, V_1, V_2, M_1,
+       * M_2, T) with associated flow, and a full n x n tangent D_t. The yield values
+       * F_y,i are FacetSprings::yield_values of the smaller yield stress of the two cells
+       * (those of the uncoupled law), the Bouc-Wen parameters cell a's. The state is
+       * z = (z_1, ..., z_n), one double per spring.
        */
       template <int dim>
       class Coupled : public SpringLaw<dim>
@@ -27,15 +32,14 @@ namespace hysteron
         unsigned int
         n_state_variables() const override
         {
-          return 3;
+          return n;
         }
 
         std::string
         unsupported(const Material::Interface<dim> &material) const override
         {
           const auto behaviour = material.spring_behaviour();
-          return behaviour.bouc_wen ? Material::BoucWenInteraction::unsupported(*behaviour.bouc_wen) :
-                                      std::string();
+          return behaviour.bouc_wen ? Law::unsupported(*behaviour.bouc_wen) : std::string();
         }
 
         bool
@@ -49,10 +53,7 @@ namespace hysteron
           if (prm == nullptr)
             return false;
           Facet &facet = facets(e);
-          if constexpr (dim == 2)
-            facet.law.reinit(*prm, springs.k, springs.yield_values(facet_yield_stress<dim>(a, b)));
-          else
-            throw InputError("RBSN/Spring law", "the coupled law is two-dimensional");
+          facet.law.reinit(*prm, springs.k, springs.yield_values(facet_yield_stress<dim>(a, b)));
           facet.law.initialize_state(state);
           facet.k = springs.k;
           facet.a = prm->post_yield_ratio;
@@ -68,8 +69,7 @@ namespace hysteron
         {
           try
             {
-              if constexpr (dim == 2)
-                facets[e].law.update(increment, force, state, tangent);
+              facets[e].law.update(increment, force, state, tangent);
             }
           catch (const RuntimeError &error)
             {
@@ -77,7 +77,7 @@ namespace hysteron
             }
         }
 
-        /// Phi^n of the facet, the same value for the three springs.
+        /// Phi^n of the facet, the same value for all its springs.
         double
         h1(const unsigned int e, const unsigned int, const double *state) const override
         {
@@ -93,6 +93,8 @@ namespace hysteron
           return bouc_wen_strain_energy(facets[e].a, facets[e].k[i], delta, state[i]);
         }
 
+        /// Its springs yield together, they are not uniaxial laws (uniaxial_spring() gives
+        /// none).
         std::string
         variable_order_unsupported() const override
         {
@@ -101,11 +103,16 @@ namespace hysteron
         }
 
       private:
+        using Law = Material::BoucWenInteraction<n>;
+        static_assert(std::is_same_v<typename Law::Vector, Vector> &&
+                        std::is_same_v<typename Law::Matrix, Matrix>,
+                      "the law works on the facet's vectors and matrices");
+
         struct Facet
         {
-          Material::BoucWenInteraction law;
-          Vector                       k{};
-          double                       a = 0; ///< post-yield ratio
+          Law    law;
+          Vector k{};
+          double a = 0; ///< post-yield ratio
         };
         PerFacet<Facet> facets;
       };
@@ -115,9 +122,11 @@ namespace hysteron
 
 HYSTERON_REGISTER_SPRING_LAW(hysteron::RBSN::Coupled,
                              "coupled",
-                             "one Bouc-Wen law for the three springs with the yield criterion "
-                             "(F^h_n / F^h_y,n)^2 + (F^h_t / F^h_y,t)^2 + (M^h / M^h_y)^2 <= 1 in the "
-                             "hysteretic forces F^h = (1 - a) k z and associated flow (eq. "
-                             "3.38-3.42; F^h_y = (1 - a) F_y), a full 3 x 3 facet tangent; it reduces "
-                             "to the uncoupled law when one component is loaded alone. No "
-                             "degradation. See doc/rbsn_coupled_springs.md")
+                             "one Bouc-Wen law for all springs of a facet (2D: F_n, F_t, M; 3D: "
+                             "N, V_1, V_2, M_1, M_2, T) with the yield criterion sum_i "
+                             "(F^h_i / F^h_y,i)^2 <= 1 in the hysteretic forces F^h = (1 - a) k z "
+                             "and associated flow (eq. 3.38-3.42; F^h_y = (1 - a) F_y, F_y the "
+                             "uncoupled law's yield values), a full facet tangent (3 x 3 in 2D, "
+                             "6 x 6 in 3D); it reduces to the uncoupled law when one spring is "
+                             "loaded alone. No degradation; not for Analysis = variable order. See "
+                             "doc/rbsn_coupled_springs.md")

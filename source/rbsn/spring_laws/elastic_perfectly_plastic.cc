@@ -10,16 +10,18 @@ namespace hysteron
     namespace
     {
       /**
-       * Rate-independent elastic-perfectly-plastic springs: each of the three springs
-       * is elastic, F_i = k_i (delta_i - delta^p_i), while |F_i| < F_y,i and flows at
-       * |F_i| = F_y,i (FacetSprings::yield_values of the smaller yield stress of the two
-       * cells' Bouc-Wen materials; the Bouc-Wen shape parameters are not used). The
-       * update is the exact return map of the increment: the trial force
-       * F + k d delta is cut back to +-F_y, the cut-off part (|F_trial| - F_y) / k is
-       * plastic deformation; the tangent is k elastically and 0 at yield.
+       * Rate-independent elastic-perfectly-plastic springs: each spring of the facet
+       * (three in 2D, six in 3D) is elastic, F_i = k_i (delta_i - delta^p_i), while
+       * |F_i| < F_y,i and flows at |F_i| = F_y,i (FacetSprings::yield_values of the
+       * smaller yield stress of the two cells' Bouc-Wen materials; the Bouc-Wen shape
+       * parameters are not used). The update is the exact return map of the increment:
+       * the trial force F + k d delta is cut back to +-F_y, the cut-off part
+       * (|F_trial| - F_y) / k is plastic deformation; the tangent is k elastically and 0
+       * at yield.
        *
        * State of spring i: state[2 i] = delta^p_i, state[2 i + 1] = |F_i| / F_y,i
-       * (the H1 output: 1 at yield).
+       * (the H1 output: 1 at yield). No uniaxial Bouc-Wen springs, hence no
+       * `Analysis = variable order` (the default variable_order_unsupported()).
        */
       template <int dim>
       class ElasticPerfectlyPlastic : public SpringLaw<dim>
@@ -112,7 +114,7 @@ namespace hysteron
 
 HYSTERON_REGISTER_SPRING_LAW(hysteron::RBSN::ElasticPerfectlyPlastic,
                              "elastic-perfectly-plastic",
-                             "three independent rate-independent springs, elastic (k) up to the "
-                             "yield value of the uncoupled law (from the smaller yield stress of the "
-                             "cells' Bouc-Wen materials) and perfectly plastic beyond; tangent k or "
-                             "0; not for Analysis = variable order")
+                             "independent rate-independent springs (three in 2D, six in 3D), "
+                             "elastic (k) up to the yield value of the uncoupled law (from the "
+                             "smaller yield stress of the cells' Bouc-Wen materials) and perfectly "
+                             "plastic beyond; tangent k or 0; not for Analysis = variable order")

@@ -12,11 +12,14 @@ namespace hysteron
     namespace
     {
       /**
-       * Three independent uniaxial Bouc-Wen springs (eq. 3.32-3.36), each with its own
-       * yield value F_y,i (FacetSprings::yield_values of the smaller yield stress of the
-       * two cells) and the Bouc-Wen parameters of cell a's material. The state of spring
-       * i lies at state[3 i] (BoucWenUniaxial::max_n_state_variables each: z, and eta
-       * and e_h with degradation); the tangent is diagonal.
+       * One independent uniaxial Bouc-Wen law per spring (eq. 3.32-3.36): three in 2D
+       * (normal, tangential, rotational), six in 3D (normal, two shear, two bending,
+       * torsion), each with its own stiffness k_i and yield value F_y,i
+       * (FacetSprings::yield_values of the smaller yield stress of the two cells) and the
+       * Bouc-Wen parameters of cell a's material. The state of spring i lies at
+       * state[3 i] (BoucWenUniaxial::max_n_state_variables each: z, and eta and e_h with
+       * degradation); the tangent is diagonal. The springs are the uniaxial laws that
+       * `Analysis = variable order` integrates (uniaxial_spring()).
        */
       template <int dim>
       class Uncoupled : public SpringLaw<dim>
@@ -123,7 +126,9 @@ namespace hysteron
 
 HYSTERON_REGISTER_SPRING_LAW(hysteron::RBSN::Uncoupled,
                              "uncoupled",
-                             "three uniaxial Bouc-Wen laws (eq. 3.36), each yielding at its own "
-                             "F_y: sigma_y t l (normal), sigma_y t l / sqrt(3) (tangential), "
-                             "factor sigma_y t l^2 (rotational); sigma_y and the Bouc-Wen "
-                             "parameters from the cells' material")
+                             "one uniaxial Bouc-Wen law per spring (eq. 3.36), each yielding at its "
+                             "own F_y: 2D sigma_y t l (normal), sigma_y t l / sqrt(3) (tangential), "
+                             "factor sigma_y t l^2 (rotational); 3D sigma_y A (normal), "
+                             "sigma_y A / sqrt(3) (shear), factor sigma_y A sqrt(12 I / A) "
+                             "(bending), factor sigma_y / sqrt(3) A sqrt(12 J / A) (torsion); "
+                             "sigma_y and the Bouc-Wen parameters from the cells' material")
