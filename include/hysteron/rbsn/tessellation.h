@@ -99,12 +99,26 @@ namespace hysteron
                         const std::uint64_t                  seed,
                         const std::string                   &where);
 
+    /**
+     * 3D: as above in the polyhedral domain of voronoi() at the resolution
+     * @p boundary_h (0: 0.25 d.min, the RBSN's default `Curved boundary resolution`;
+     * pass the one given to voronoi() so that every point lies in its domain). The
+     * front grows on the unit sphere's directions at radii [d, 2 d]; the gaps are
+     * swept with darts per uncovered cube of side d_min / sqrt(3), then per eighth of
+     * it for 2 levels. Fixed points on the domain's boundary own it: where they cover
+     * a face (the empty circumcircles of their Delaunay triangles in the face, radius
+     * below 1.25 d), no random point is put within a circumball, so that no random
+     * point's cell reaches that face. Throws InputError(@p where) unless d > 0, for an
+     * unbounded body (`all`), and for more than 5e6 points predicted (density V / d^3
+     * for a constant d, d.predicted_points otherwise).
+     */
     std::vector<dealii::Point<3>>
     poisson_disk_points(const Geometry::Region<3>           &domain,
                         const Spacing<3>                    &d,
                         const std::vector<dealii::Point<3>> &fixed,
                         const std::uint64_t                  seed,
-                        const std::string                   &where);
+                        const std::string                   &where,
+                        const double                         boundary_h = 0);
 
     /// As above for a constant d_m > 0 (throws InputError(@p where) otherwise).
     std::vector<dealii::Point<2>>
