@@ -819,6 +819,11 @@ namespace hysteron
       Domain::primitive_contains(const Primitive &q, const Point &p, const double t) const
       {
         const Plane *plane = planes.data() + q.first_plane;
+        // Outside its box (grown by more than any grown corner moves): outside.
+        const double margin = 10 * std::abs(t) + tolerance;
+        for (unsigned int d = 0; d < 3; ++d)
+          if (p[d] < q.box.lo[d] - margin || p[d] > q.box.hi[d] + margin)
+            return false;
         switch (q.shape)
           {
             case Primitive::Shape::box:
@@ -850,6 +855,8 @@ namespace hysteron
                 const double rho = y.norm();
                 if (rho <= q.inradius + t)
                   return true;
+                if (rho > q.outradius + 2 * std::abs(t) + tolerance) // the vertices lie on the sphere
+                  return false;
                 Box direction;
                 direction.add(Point(y / rho));
                 std::vector<unsigned int> faces;
@@ -1193,16 +1200,20 @@ namespace hysteron
       double
       Domain::volume() const
       {
-        ConvexPolyhedron X;
-        const Vector     margin({0.01 * scale, 0.01 * scale, 0.01 * scale});
-        X.make_box(box.lo - margin, box.hi + margin, box_tag);
-        Clipper                       clipper(tolerance);
-        std::vector<ConvexPolyhedron> pieces;
-        intersect(X, pieces, clipper);
-        Moments m;
-        for (const auto &piece : pieces)
-          m.add_volume(piece, Point(0.5 * (box.lo + box.hi)));
-        return m.measure;
+        return volume(boundary());
+      }
+
+
+
+      double
+      Domain::volume(const std::vector<BoundaryPolygon> &boundary)
+      {
+        // The divergence theorem with div x = 3: V = 1/3 sum over the boundary of
+        // x . n A (x any point of a planar polygon: x . n is constant on it).
+        double v = 0;
+        for (const auto &b : boundary)
+          v += b.polygon.vertices[0] * area_vector(b.polygon.vertices.data(), b.polygon.vertices.size()) / 3;
+        return v;
       }
     } // namespace Polyhedral
   }   // namespace RBSN

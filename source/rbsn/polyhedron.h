@@ -338,9 +338,13 @@ namespace hysteron
         std::vector<BoundaryPolygon>
         boundary() const;
 
-        /// The volume of the polyhedral domain (exact sum over its pieces).
+        /// The volume of the polyhedral domain (by the divergence theorem over its boundary).
         double
         volume() const;
+
+        /// The volume enclosed by @p boundary (from boundary()).
+        static double
+        volume(const std::vector<BoundaryPolygon> &boundary);
 
         const Plane &
         plane(const unsigned int p) const

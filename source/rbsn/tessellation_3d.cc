@@ -222,19 +222,19 @@ namespace hysteron
         covers(const Point *corners, const unsigned int count) const
         {
           Vector mid;
-          double half = 0;
           for (unsigned int c = 0; c < count; ++c)
             mid += corners[c];
           mid /= static_cast<double>(count);
-          for (unsigned int c = 0; c < count; ++c)
-            half = std::max(half, corners[c].distance(Point(mid)));
+          // A ball that holds the corners holds their mean: |centre - mid| < R.
           const auto holds = [&](const Point &centre, const double R) {
+            if (centre.distance_square(Point(mid)) >= R * R)
+              return false;
             for (unsigned int c = 0; c < count; ++c)
               if (corners[c].distance_square(centre) >= R * R)
                 return false;
             return true;
           };
-          const int reach = static_cast<int>(std::ceil((d.max * shrink + half) / cell));
+          const int reach = static_cast<int>(std::ceil(d.max * shrink / cell));
           const int i = at(mid[0], 0), j = at(mid[1], 1), k = at(mid[2], 2);
           for (int z = std::max(0, k - reach); z <= std::min(n[2] - 1, k + reach); ++z)
             for (int y = std::max(0, j - reach); y <= std::min(n[1] - 1, j + reach); ++y)
@@ -333,7 +333,10 @@ namespace hysteron
        * points are left alone) are returned.
        */
       std::vector<std::pair<Point, double>>
-      boundary_balls(const Polyhedral::Domain &domain, const std::vector<Point> &fixed, const Spacing<3> &d)
+      boundary_balls(const Polyhedral::Domain                       &domain,
+                     const std::vector<Polyhedral::BoundaryPolygon> &polygons,
+                     const std::vector<Point>                       &fixed,
+                     const Spacing<3>                               &d)
       {
         using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
         using Vb     = CGAL::Triangulation_vertex_base_with_info_2<unsigned int, Kernel>;
@@ -342,7 +345,6 @@ namespace hysteron
         std::vector<std::pair<Point, double>> balls;
         if (fixed.size() < 3)
           return balls;
-        const auto   polygons  = domain.boundary();
         const auto   groups    = face_groups(polygons);
         const double tolerance = 1e-9 * domain.scale;
         std::vector<unsigned int> group_of(polygons.size());
@@ -508,11 +510,13 @@ namespace hysteron
     {
       require(d.min > 0 && d.max >= d.min && std::isfinite(d.max), where, "the minimum distance must be > 0");
       const Polyhedral::Domain domain({&region}, boundary_h > 0 ? boundary_h : 0.25 * d.min, where);
+      const auto boundary = domain.boundary();
       {
         // The saturated set's size: density V / d^3 for a constant d (V of the
         // polyhedral domain), else the sampled prediction.
-        const double predicted =
-          d.is_constant() ? Spacing<3>::density * domain.volume() / (d.min * d.min * d.min) : d.predicted_points;
+        const double predicted = d.is_constant() ?
+                                   Spacing<3>::density * Polyhedral::Domain::volume(boundary) / (d.min * d.min * d.min) :
+                                   d.predicted_points;
         std::ostringstream s;
         s << "about " << static_cast<long>(predicted) << " points predicted at this minimum distance ("
           << Spacing<3>::density << " int 1/d^3 dV over the body; at most 5e6)";
@@ -524,7 +528,7 @@ namespace hysteron
         grid.add(p, d(p));
       // The fixed points on the boundary own it: no random point may come closer to
       // a piece of it than they are.
-      grid.forbid(boundary_balls(domain, fixed, d));
+      grid.forbid(boundary_balls(domain, boundary, fixed, d));
       const auto in_domain = [&](const Point &p) { return domain.contains(p); };
 
       // Bridson: grow from active points by trials in the shell [d, 2 d] around them

@@ -405,6 +405,22 @@ TEST(Tessellation3D, CellsTileAnLAndASphere)
   for (const auto &f : sphere.primitives()[0].faces)
     sphere_area += area_vector(f).norm();
   EXPECT_NEAR(area, 2 * 3 + 8 + sphere_area, 1e-12); // the L: top and bottom 3 m^2, sides 8 m^2
+  // The cells' boundary faces cover that surface once (none on the plane y = 1 inside the L).
+  double cells_area = 0;
+  for (const auto &c : t.cells)
+    for (const auto &loop : c.boundary)
+      {
+        cells_area += area_vector(loop).norm();
+        bool   on_plane = true;
+        double x        = 0;
+        for (const auto &v : loop)
+          {
+            on_plane = on_plane && std::abs(v[1] - 1) < 1e-12;
+            x += v[0] / loop.size();
+          }
+        EXPECT_FALSE(on_plane && x < 1);
+      }
+  EXPECT_NEAR(cells_area, area, 1e-12);
 }
 
 
@@ -738,4 +754,35 @@ TEST(Tessellation3D, DISABLED_MeasureDensity)
     }
   const double mean = sum / 4;
   std::cout << "mean " << mean << ", standard deviation " << std::sqrt((sum2 / 4 - mean * mean) * 4 / 3) << std::endl;
+}
+
+
+
+// The same for curved bodies at the default resolution h = d / 4: a ball (a geodesic
+// polyhedron of edges <= h) and a plate with 4 bores (prisms); run as above with
+// --gtest_filter='Tessellation3D.DISABLED_TimingCurved'.
+TEST(Tessellation3D, DISABLED_TimingCurved)
+{
+  for (const std::string expression :
+       {"sphere(0, 0, 0, 1)",
+        "box(0, 0, 0, 2, 2, 0.4) - cylinder(0.5, 0.5, -1, 0.5, 0.5, 1, 0.25) - cylinder(1.5, 0.5, -1, 1.5, 0.5, 1, "
+        "0.25) - cylinder(0.5, 1.5, -1, 0.5, 1.5, 1, 0.25) - cylinder(1.5, 1.5, -1, 1.5, 1.5, 1, 0.25)"})
+    {
+      const double           d      = 0.06;
+      const auto             region = parse(expression);
+      const RBSN::Spacing<3> spacing(d);
+      dealii::Timer          timer;
+      const auto             fixed = RBSN::boundary_points(region, spacing, 0.25 * d, 1);
+      const double           t1    = timer.wall_time();
+      const auto             p     = RBSN::poisson_disk_points(region, spacing, fixed, 2, "RBSN", 0.25 * d);
+      const double           t2    = timer.wall_time();
+      const auto             t     = RBSN::voronoi(p, {&region}, 0.25 * d, "Body names");
+      const double           t3    = timer.wall_time();
+      double                 volume = 0;
+      for (const auto &c : t.cells)
+        volume += c.volume;
+      std::cout << expression << ", d = " << d << ": " << fixed.size() << " boundary nuclei in " << t1 << " s, "
+                << p.size() << " nuclei in " << t2 - t1 << " s, " << t.facets.size() << " facets in " << t3 - t2
+                << " s; total " << t3 << " s; volume " << volume << std::endl;
+    }
 }
