@@ -595,6 +595,10 @@ TEST(Tessellation3D, Errors)
             "B: two points coincide at (0.5, 0.5, 0.5)");
   EXPECT_EQ(message([&]() { RBSN::voronoi({Point<3>(0.5, 0.5, 0.5)}, {&region}, 0.1, "B"); }),
             "B: a network needs at least two cells");
+  // A nucleus just outside a face (within the tolerance 1e-9 of the box's size) whose
+  // cell is cut off by the face: no volume.
+  EXPECT_EQ(message([&]() { RBSN::voronoi({Point<3>(1 + 1e-10, 0.5, 0.5), Point<3>(1 - 1e-10, 0.5, 0.5)}, {&region}, 0.1, "B"); }),
+            "B: the cell of the point (1, 0.5, 0.5) has no volume in the bodies");
   const auto all = parse("all - box(0, 0, 0, 1, 1, 1)");
   EXPECT_NE(message([&]() { RBSN::poisson_disk_points(all, RBSN::Spacing<3>(0.1), {}, 1, "RBSN/Minimum distance"); })
               .find("RBSN/Minimum distance: the shape 'all - box(0, 0, 0, 1, 1, 1)' contains 'all'"),
