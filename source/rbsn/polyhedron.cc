@@ -6,7 +6,6 @@
 #include <cmath>
 #include <map>
 #include <numeric>
-#include <tuple>
 
 namespace hysteron
 {
@@ -20,6 +19,47 @@ namespace hysteron
         unit(const Vector &v)
         {
           return v / v.norm();
+        }
+
+        /**
+         * Whether the convex planar polygon @p face (on @p plane) meets the box @p b grown
+         * by @p tolerance: no separating axis among the box's axes (the boxes already
+         * overlap), the polygon's normal, and the cross products of its edges with the
+         * box's axes.
+         */
+        bool
+        meets(const std::vector<Point> &face, const Plane &plane, const Box &b, const double tolerance)
+        {
+          const Point  centre = Point(0.5 * (b.lo + b.hi));
+          const Vector half   = 0.5 * (b.hi - b.lo);
+          const auto   radius = [&](const Vector &axis) {
+            return std::abs(axis[0]) * half[0] + std::abs(axis[1]) * half[1] + std::abs(axis[2]) * half[2];
+          };
+          if (std::abs(plane(centre)) > radius(plane.normal) + tolerance)
+            return false;
+          for (unsigned int e = 0; e < face.size(); ++e)
+            {
+              const Vector edge = face[(e + 1) % face.size()] - face[e];
+              for (unsigned int k = 0; k < 3; ++k)
+                {
+                  Vector a;
+                  a[k]               = 1;
+                  const Vector axis  = cross_product_3d(edge, a);
+                  const double norm  = axis.norm();
+                  if (norm <= 1e-12 * edge.norm())
+                    continue;
+                  double lo = std::numeric_limits<double>::max(), hi = -lo;
+                  for (const auto &v : face)
+                    {
+                      lo = std::min(lo, axis * (v - centre));
+                      hi = std::max(hi, axis * (v - centre));
+                    }
+                  const double r = radius(axis);
+                  if (lo > r + tolerance * norm || hi < -r - tolerance * norm)
+                    return false;
+                }
+            }
+          return true;
         }
       } // namespace
 
@@ -928,19 +968,21 @@ namespace hysteron
       void
       Domain::near_planes(const Primitive &q, const Box &b, std::vector<unsigned int> &result) const
       {
+        // The faces that meet the box (their boxes first). Only those bound P inside it.
         result.clear();
         if (q.face_tree.empty())
           {
             for (unsigned int f = 0; f < q.faces.size(); ++f)
               if (q.face_boxes[f].overlaps(b, tolerance))
-                result.push_back(q.first_plane + f);
+                result.push_back(f);
           }
         else
-          {
-            q.face_tree.query(b, tolerance, result);
-            for (auto &f : result)
-              f += q.first_plane;
-          }
+          q.face_tree.query(b, tolerance, result);
+        unsigned int kept = 0;
+        for (const unsigned int f : result)
+          if (meets(q.faces[f], planes[q.first_plane + f], b, 2 * tolerance))
+            result[kept++] = q.first_plane + f;
+        result.resize(kept);
       }
 
 
@@ -957,9 +999,9 @@ namespace hysteron
           {
             case Geometry::Region<3>::Op::push:
               {
-                // X n P = X n (the half-spaces of the faces of P near X): within X's box
-                // P is bounded by those faces alone (a face far away cannot bound it
-                // there). Without a face near, X lies inside P or outside.
+                // X n P = X n (the half-spaces of the faces of P that meet X's box B):
+                // within B, P is bounded by those faces alone. Without such a face, X
+                // lies inside P or outside.
                 int dropped = -1;
                 if (side != nullptr)
                   for (const auto &c : side->changes)

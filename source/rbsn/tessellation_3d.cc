@@ -1065,12 +1065,19 @@ namespace hysteron
               const unsigned int j = o.second;
               const Vector       d = nuclei[j] - x;
               const Plane        bisector{d / d.norm(), (d / d.norm()) * Point(0.5 * (x + nuclei[j]))};
-              if (clipper.clip(X, bisector, static_cast<int>(j), next) == Cut::cut)
+              const Cut cut = clipper.clip(X, bisector, static_cast<int>(j), next);
+              if (cut == Cut::cut)
                 std::swap(X, next);
+              else if (cut == Cut::outside) // nuclei closer than the tolerance: no cell
+                {
+                  X.clear();
+                  break;
+                }
             }
           // Its pieces in the domain.
           pieces.clear();
-          domain.intersect(X, pieces, clipper);
+          if (!X.empty())
+            domain.intersect(X, pieces, clipper);
 
           Cell<3> &cell = result.cells[i];
           cell.nucleus  = x;
