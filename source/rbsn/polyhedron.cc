@@ -620,7 +620,8 @@ namespace hysteron
               if (p != q && plane_primitive[p] != plane_primitive[q])
                 {
                   const double same = planes[p].normal * planes[q].normal;
-                  const double gap  = same > 0 ? planes[p].offset - planes[q].offset : planes[p].offset + planes[q].offset;
+                  const double gap =
+                    same > 0 ? planes[p].offset - planes[q].offset : planes[p].offset + planes[q].offset;
                   if (std::abs(std::abs(same) - 1) < 1e-12 && std::abs(gap) < 1e3 * tolerance)
                     coplanar[p].emplace_back(q, same > 0);
                 }

@@ -413,7 +413,10 @@ namespace hysteron
        * if @p with_start.
        */
       void
-      spread(const std::vector<Point> &path, const Spacing<3> &spacing, const bool with_start, std::vector<Point> &points)
+      spread(const std::vector<Point> &path,
+             const Spacing<3>         &spacing,
+             const bool                with_start,
+             std::vector<Point>       &points)
       {
         double length = 0;
         for (unsigned int k = 0; k + 1 < path.size(); ++k)
@@ -514,9 +517,9 @@ namespace hysteron
       {
         // The saturated set's size: density V / d^3 for a constant d (V of the
         // polyhedral domain), else the sampled prediction.
-        const double predicted = d.is_constant() ?
-                                   Spacing<3>::density * Polyhedral::Domain::volume(boundary) / (d.min * d.min * d.min) :
-                                   d.predicted_points;
+        const double volume    = Polyhedral::Domain::volume(boundary);
+        const double predicted = d.is_constant() ? Spacing<3>::density * volume / (d.min * d.min * d.min) :
+                                                   d.predicted_points;
         std::ostringstream s;
         s << "about " << static_cast<long>(predicted) << " points predicted at this minimum distance ("
           << Spacing<3>::density << " int 1/d^3 dV over the body; at most 5e6)";
@@ -919,8 +922,9 @@ namespace hysteron
             for (unsigned int attempt = 0; attempt < trials; ++attempt)
               {
                 const double pick = uniform(rng) * total;
-                const auto   t    = std::min<std::size_t>(
-                  std::upper_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin(), triangles.size() - 1);
+                const auto   t    = std::min<std::size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), pick) -
+                                                           cumulative.begin(),
+                                                         triangles.size() - 1);
                 double u = uniform(rng), v = uniform(rng);
                 if (u + v > 1)
                   {
@@ -1115,7 +1119,8 @@ namespace hysteron
                       // domain does not continue are boundary (the rest is a cut
                       // between two pieces of this cell).
                       const unsigned int plane = tag_plane(tag);
-                      ConvexPolygon      G{face, tag_flipped(tag) ? -domain.plane(plane).normal : domain.plane(plane).normal};
+                      const Vector       n = domain.plane(plane).normal;
+                      ConvexPolygon      G{face, tag_flipped(tag) ? -n : n};
                       parts.clear();
                       domain.boundary_part(G, plane, parts, clipper);
                       for (auto &part : parts)

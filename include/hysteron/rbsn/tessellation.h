@@ -267,7 +267,8 @@ namespace hysteron
       /// about axis_2 [m^4] (xi from the centroid), I_1 >= I_2.
       dealii::Tensor<1, 3> axis_1, axis_2;
       double               second_moment_1 = 0, second_moment_2 = 0;
-      /// The facet's pieces in the domain: planar loops (output).
+      /// The facet's pieces in the domain: planar loops, counter-clockwise about normal
+      /// (the faces of cell a's pieces on the bisector; output).
       std::vector<std::vector<dealii::Point<3>>> polygons;
     };
 
