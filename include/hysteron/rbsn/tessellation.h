@@ -57,8 +57,11 @@ namespace hysteron
        * bounds of d, its largest gradient (finite differences of neighbouring samples)
        * and the predicted number of points of a saturated set, 0.68 int 1/d^2 dA in 2D
        * and 0.70 int 1/d^3 dV in 3D (midpoint rule; exact for a constant d up to the
-       * measure's estimate; the 3D coefficient is the jamming density of random
-       * sequential addition of spheres of diameter d, 0.38 = (pi/6) n d^3).
+       * measure's estimate). The 3D coefficient is measured (doc/rbsn/geometry_3d.md):
+       * n d^3 / V = 0.702 away from the faces of a unit cube with d = 0.02, 4 seeds,
+       * standard deviation 0.0007; random sequential addition of spheres of diameter
+       * d jams at 0.384 = (pi/6) n d^3, n d^3 = 0.734, which the front and the darts
+       * approach to 96 %.
        */
       void
       sample(const std::vector<const Geometry::Region<dim> *> &bodies);
@@ -99,12 +102,26 @@ namespace hysteron
                         const std::uint64_t                  seed,
                         const std::string                   &where);
 
+    /**
+     * 3D: as above in the polyhedral domain of voronoi() at the resolution
+     * @p boundary_h (0: 0.25 d.min, the RBSN's default `Curved boundary resolution`;
+     * pass the one given to voronoi() so that every point lies in its domain). The
+     * front grows on the unit sphere's directions at radii [d, 2 d]; the gaps are
+     * swept with darts per uncovered cube of side d_min / sqrt(3), then per eighth of
+     * it for 2 levels. Fixed points on the domain's boundary own it: where they cover
+     * a face (the empty circumcircles of their Delaunay triangles in the face, radius
+     * below 1.25 d), no random point is put within a circumball, so that no random
+     * point's cell reaches that face. Throws InputError(@p where) unless d > 0, for an
+     * unbounded body (`all`), and for more than 5e6 points predicted (density V / d^3
+     * for a constant d, d.predicted_points otherwise).
+     */
     std::vector<dealii::Point<3>>
     poisson_disk_points(const Geometry::Region<3>           &domain,
                         const Spacing<3>                    &d,
                         const std::vector<dealii::Point<3>> &fixed,
                         const std::uint64_t                  seed,
-                        const std::string                   &where);
+                        const std::string                   &where,
+                        const double                         boundary_h = 0);
 
     /// As above for a constant d_m > 0 (throws InputError(@p where) otherwise).
     std::vector<dealii::Point<2>>
@@ -128,11 +145,17 @@ namespace hysteron
     /**
      * 3D: points on the boundary of the polyhedral domain (the region with its
      * curved primitives as polyhedra at resolution @p boundary_h, see voronoi()):
-     * the corners, points along the edges (where two faces meet at more than 20
-     * degrees) at most the local d apart, and Poisson-disk points on every face
-     * keeping min(d(p), d(q)) from the others, so that the cells of the boundary
-     * have their nuclei on it (supports and loads act there). Deterministic for
-     * a @p seed.
+     * the corners (where sharp edges meet or turn by more than 20 degrees), points
+     * along the sharp edges (where the surface turns by more than 20 degrees) at
+     * equal steps of int ds / d between corners (at most the local d apart), and
+     * Poisson-disk points on every planar face (Bridson's front in its plane from
+     * the points on its edges, then darts into the uncovered squares of a grid of
+     * side d_min / sqrt(2) and their quarters, 2 levels), each keeping
+     * min(d(p), d(q)) from all points so far. Order: corners, edge points, face
+     * points. With the random points of poisson_disk_points() (given these as
+     * fixed points), the cells that touch a face have their nuclei on it (supports
+     * and loads act there). Deterministic for a @p seed. Throws InputError for an
+     * unbounded body.
      */
     std::vector<dealii::Point<3>>
     boundary_points(const Geometry::Region<3> &domain,
@@ -244,7 +267,8 @@ namespace hysteron
       /// about axis_2 [m^4] (xi from the centroid), I_1 >= I_2.
       dealii::Tensor<1, 3> axis_1, axis_2;
       double               second_moment_1 = 0, second_moment_2 = 0;
-      /// The facet's pieces in the domain: planar loops (output).
+      /// The facet's pieces in the domain: planar loops, counter-clockwise about normal
+      /// (the faces of cell a's pieces on the bisector; output).
       std::vector<std::vector<dealii::Point<3>>> polygons;
     };
 
@@ -286,12 +310,19 @@ namespace hysteron
     /**
      * 3D: the Voronoi cells of @p nuclei (from CGAL's 3D Delaunay triangulation,
      * each cell the intersection of the half-spaces of the bisectors of its Delaunay
-     * neighbours) clipped exactly to the union of @p bodies, whose curved primitives
-     * (spheres, cylinders) are polyhedra with edges of at most @p boundary_h. Each
-     * cell's volume, centroid and second moment are exact integrals over its convex
-     * pieces; a facet is the common face of two cells inside the domain, with its
-     * area, centroid and principal second moments over all its pieces. @p wanted, the
-     * order of the facets and the errors as in 2D.
+     * neighbours; coplanar or collinear nuclei work too) clipped exactly to the union
+     * of @p bodies, whose curved primitives are polyhedra: a cylinder the inscribed
+     * prism of Region<2>::n_disk_sides(r, boundary_h) sides, a sphere an inscribed
+     * geodesic polyhedron (a subdivided icosahedron) with edges of at most
+     * @p boundary_h. A clipped cell is a union of disjoint convex pieces (one for a
+     * cell that no subtracted primitive or union cuts); its volume, centroid and
+     * second moment are exact integrals over them. A facet is the common face of two
+     * cells inside the domain: its area, centroid, the principal second moments
+     * of area and axes over all its pieces; facets of area below 1e-12 scale^2 are
+     * dropped. Cell::boundary holds the parts of the domain's boundary in the cell
+     * (not the cuts between its pieces). @p wanted, the order of the facets and the
+     * errors as in 2D, and a cell with no volume in the bodies is an error.
+     * doc/rbsn/geometry_3d.md derives the clipping and the integrals.
      */
     Tessellation<3>
     voronoi(const std::vector<dealii::Point<3>>            &nuclei,
