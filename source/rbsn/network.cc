@@ -17,9 +17,12 @@
 #include <hysteron/base/exceptions.h>
 #include <hysteron/rbsn/model.h>
 
+#include "rbsn/polyhedron.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <numeric>
 #include <sstream>
 
@@ -215,8 +218,13 @@ namespace hysteron
       for (unsigned int s = 0; s < body_shapes.size(); ++s)
         {
           // Each body is filled in turn, keeping the distance from every point so far.
-          auto filled = poisson_disk_points(*body_shapes[s], spacing, points,
-                                            scene.random_seed() + 7919 * s, "RBSN/Minimum distance");
+          std::vector<dealii::Point<dim>> filled;
+          if constexpr (dim == 2)
+            filled = poisson_disk_points(*body_shapes[s], spacing, points, scene.random_seed() + 7919 * s,
+                                         "RBSN/Minimum distance");
+          else
+            filled = poisson_disk_points(*body_shapes[s], spacing, points, scene.random_seed() + 7919 * s,
+                                         "RBSN/Minimum distance", boundary_h);
           points.swap(filled);
         }
       require(points.size() >= 2,
@@ -254,9 +262,22 @@ namespace hysteron
       cell_body.assign(n_local, 0);
       const auto lo = bodies[mesh_body[0]].shape.bounding_box().get_boundary_points();
       scale         = lo.first.distance(lo.second);
+      // In 3D the bodies as the polyhedra the cells are clipped to: a nucleus on the
+      // polyhedral surface of a subtracted sphere or cylinder lies inside the exact one.
+      std::vector<std::unique_ptr<Polyhedral::Domain>> polyhedra;
+      if constexpr (dim == 3)
+        for (const auto *shape : body_shapes)
+          polyhedra.push_back(std::make_unique<Polyhedral::Domain>(
+            std::vector<const Geometry::Region<3> *>{shape}, boundary_h, "Body names"));
+      const auto in_body = [&](const unsigned int s, const dealii::Point<dim> &p) {
+        if constexpr (dim == 3)
+          return polyhedra[s]->contains(p, 1e-9 * scale);
+        else
+          return body_shapes[s]->contains(p, 1e-9 * scale);
+      };
       for (unsigned int c = 0; c < n_local; ++c)
         for (unsigned int s = 0; s < body_shapes.size(); ++s)
-          if (body_shapes[s]->contains(nuclei[cell_id[c]], 1e-9 * scale))
+          if (in_body(s, nuclei[cell_id[c]]))
             {
               cell_body[c] = mesh_body[s];
               break;
