@@ -158,7 +158,10 @@ namespace hysteron
             methods[m] = Registry<dim>::create(names[m], where);
             methods[m]->set_output_subdirectory(names[m]);
             methods[m]->initialize(this->get_scene(), prm);
-            labels[m] = names[m] == "mpm" ? "MPM" : names[m] == "fem" ? "FEM" : names[m];
+            labels[m] = names[m] == "mpm"  ? "MPM" :
+                        names[m] == "fem"  ? "FEM" :
+                        names[m] == "rbsn" ? "RBSN" :
+                                             names[m];
           }
       }
 
