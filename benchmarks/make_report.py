@@ -21,6 +21,8 @@ Studies (name: script; minutes on the 2-core Xeon VM with --repeats 3):
   calculix_cantilever_3d       3D plastic cantilever, FEM against CalculiX 2.20 (C3D20)       8
   rbsn_run_time                RBSN cantilever / titanium plate against cells                 4
   rbsn_large                   RBSN 100k-cell elastic plate, 10k-cell plastic cantilever      6
+  rbsn_3d                      RBSN 3D: 20k-cell elastic box, 5k-cell plastic cantilever,    45
+                               both on 2 ranks (runs alone: pins its own 1-rank runs)
   rbsn_incremental_assembly    RBSN tangent updated in place against assembled from zero       3
   rbsn_cantilever_plastic      §5.1 RBSN, uncoupled against coupled springs                   3
   rbsn_newmark_vs_variable_order  §3.6.1 element, Newmark against IDA                        3
@@ -31,7 +33,7 @@ Studies (name: script; minutes on the 2-core Xeon VM with --repeats 3):
 
 Each study runs pinned to one core (taskset). With --lanes 2 two studies run at a time, one per
 core (shorter, but they share the memory bus and the L3 cache; the report says so); the
-throughput and plate studies, which need both cores for their 2-rank runs, then run alone at
+throughput, plate and 3D RBSN studies, which need both cores for their 2-rank runs, then run alone at
 the end.
 --quick runs every study's quick subset into a temporary directory (throughput and callgrind
 skipped) to check the pipeline in a few minutes; its report is not for committing.
@@ -102,6 +104,10 @@ def studies(args, out, work):
               py("rbsn_run_time.py", "--repeats", r, "--output", os.path.join(out, "rbsn_run_time"), *q), 4),
         Study("rbsn_large",
               py("rbsn_large.py", "--repeats", r, "--output", os.path.join(out, "rbsn_large"), *q), 6),
+        # Its 1-rank runs pin themselves to one core and its 2-rank runs need both: alone.
+        Study("rbsn_3d",
+              py("rbsn_3d.py", "--repeats", r, "--output", os.path.join(out, "rbsn_3d"), *q), 45,
+              exclusive=True),
         Study("rbsn_incremental_assembly",
               py("rbsn_incremental_assembly.py", "--repeats", r, "--output",
                  os.path.join(out, "rbsn_incremental_assembly"), *q), 3),

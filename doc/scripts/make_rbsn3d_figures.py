@@ -105,7 +105,7 @@ def cantilever(hysteron, work):
                    Method="rbsn", Random_seed=seed)
         rs, ps = table(os.path.join(o, "reactions.csv")), table(os.path.join(o, "probe_0.csv"))
         P = [-v for v in rs["tip_y"]]
-        ax.plot([-1e3 * v for v in ps["u_y"]], [v / 1e3 for v in P], "C0:", lw=1,
+        ax.plot([-1e3 * v for v in ps["u_y"]], [v / 1e3 for v in P], "C0:" if seed == 2 else "C0-.", lw=1,
                 label=f"RBSN, seed {seed} ({n} cells)")
         print(f"RBSN seed {seed}: {n} cells, load at 50 mm {P[-1] / 1e3:.2f} kN = {P[-1] / P_U:.3f} P_u, "
               f"first yield {first_yield(rs['time'], P, 31) / P_Y:.3f} P_y")
