@@ -26,8 +26,9 @@ The largest network of each scene and solver also runs on 2 MPI ranks (both core
 direct solver gathers the matrix on rank 0: `Distributed direct solver = UMFPACK`); the speed-up
 is the 1-rank median over the 2-rank time.
 
-Time: the whole process (MPI start-up, set-up, steps, output), measured around the call, and
-hysteron's own timer sections (set-up, steps, output) of the median run. Runs whose time
+Time: the whole process (MPI start-up, set-up, steps, output), measured around the call, its CPU
+time (user + system, all ranks; less sensitive to other work on a shared machine than the wall
+time), and hysteron's own timer sections (set-up, steps, output) of the median run. Runs whose time
 exceeds --long seconds run once. Memory: the peak resident set (/usr/bin/time); per cell, the
 slope between the two largest 1-rank runs of a scene and solver (the libraries' fixed ~100 MB
 drop out). Writes CSV, Markdown and a PNG (time and memory against cells, log-log) to --output
@@ -54,6 +55,7 @@ from rbsn_run_time import rows_of, set_entry  # noqa: E402
 EPS, REACTION = 5e-4, 1e9 * 5e-4 * 0.5 * 0.5     # the box: E eps H W = 125 kN
 P_U = 240e6 * 0.1 * 0.1**2 / (4 * 1.0)           # the cantilever: 60 kN
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+LOADS = []   # the 1-minute load average before every run (the machine is shared)
 
 
 def with_solver(text, solver):
@@ -72,17 +74,19 @@ def run(hysteron, directory, text, ranks=1):
     shutil.rmtree(os.path.join(directory, "output"), ignore_errors=True)
     with open(os.path.join(directory, "scene.prm"), "w") as f:
         f.write(text)
-    command = ["/usr/bin/time", "-f", "RSS %M", hysteron, "scene.prm"]
+    timer = ["/usr/bin/time", "-f", "RSS %M CPU %U %S"]
+    command = timer + [hysteron, "scene.prm"]
     if ranks > 1:
         # Both cores: the 2 ranks are not pinned (the machine has 2).
-        command = ["/usr/bin/time", "-f", "RSS %M", "mpirun", "--oversubscribe", "-np", str(ranks),
-                   hysteron, "scene.prm"]
+        command = timer + ["mpirun", "--oversubscribe", "-np", str(ranks), hysteron, "scene.prm"]
         command = ["taskset", "-c", f"0-{os.cpu_count() - 1}"] + command
     elif shutil.which("taskset"):
         command = ["taskset", "-c", "1"] + command
+    load = float(open("/proc/loadavg").read().split()[0])
     start = time.perf_counter()
     p = subprocess.run(command, cwd=directory, env=ENV, capture_output=True, text=True)
     wall = time.perf_counter() - start
+    LOADS.append(load)
     if p.returncode != 0:
         raise RuntimeError(f"{directory}: exit {p.returncode}\n{p.stderr[-3000:]}")
     m = re.search(r"finished in [0-9.eE+-]+ s \((\d+) cells, (\d+) facets, (\d+) steps, (\d+) Newton "
@@ -92,8 +96,9 @@ def run(hysteron, directory, text, ranks=1):
     sections = dict(setup_s=0.0, steps_s=0.0, output_s=0.0)
     for name, seconds in re.findall(r"\|\s*(set-up|steps|output)\s*\|\s*\d+\s*\|\s*([0-9.]+)s", p.stdout):
         sections[names[name]] = float(seconds)
-    rss = float(re.search(r"RSS (\d+)", p.stderr).group(1)) / 1024
-    return dict(wall=wall, rss=rss, cells=int(m.group(1)), facets=int(m.group(2)), steps=int(m.group(3)),
+    usage = re.search(r"RSS (\d+) CPU ([0-9.]+) ([0-9.]+)", p.stderr)
+    rss = float(usage.group(1)) / 1024
+    return dict(wall=wall, rss=rss, cpu=float(usage.group(2)) + float(usage.group(3)), cells=int(m.group(1)), facets=int(m.group(2)), steps=int(m.group(3)),
                 newton=int(m.group(4)), factorizations=int(m.group(5)),
                 krylov=int(krylov.group(1)) if krylov else 0, **sections)
 
@@ -219,7 +224,7 @@ def main():
                 if same:
                     r["speedup"] = f"{same[0]['wall'] / r['wall']:.2f}"
     columns = ["scene", "d_m", "ranks", "solver", "cells", "facets", "newton", "factorizations", "krylov",
-               "repeats", "wall", "setup_s", "steps_s", "output_s", "rss", "kb_per_cell", "speedup", "error",
+               "repeats", "wall", "cpu", "setup_s", "steps_s", "output_s", "rss", "kb_per_cell", "speedup", "error",
                "value"]
     os.makedirs(os.path.dirname(args.output), exist_ok=True)
     with open(args.output + ".csv", "w", newline="") as f:
@@ -229,16 +234,18 @@ def main():
             w.writerow({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in r.items()})
     cpu = re.search(r"model name\s*:\s*(.*)", open("/proc/cpuinfo").read())
     header = ("| scene | d_m [m] | ranks | solver | cells | facets | Newton iterations | factorizations | "
-              "Krylov iterations | runs | total [s] | set-up [s] | steps [s] | output [s] | peak RSS [MB] | "
+              "Krylov iterations | runs | total [s] | CPU [s] | set-up [s] | steps [s] | output [s] | peak RSS [MB] | "
               "memory per cell [kB] | speed-up on 2 ranks | error | second value |")
     lines = [f"`benchmarks/rbsn_3d.py build --repeats {repeats}`: {cpu.group(1).strip() if cpu else 'unknown CPU'}, "
              f"{os.cpu_count()} cores, Release; one core (taskset -c 1) for the 1-rank runs, both for the 2-rank "
-             "ones; total = the whole process, median of the runs. The columns are explained in the script's "
-             "docstring.", "", header, "|" + "---|" * (header.count("|") - 1)]
+             "ones; total = the whole process's wall time, median of the runs; CPU = its user + system time "
+             "(all ranks). The columns are explained in the script's docstring.",
+             "", f"1-minute load average before the runs (the machine is shared): median "
+             f"{statistics.median(LOADS):.2f}, max {max(LOADS):.2f}.", "", header, "|" + "---|" * (header.count("|") - 1)]
     for r in rows:
         lines.append(f"| {r['scene']} | {r['d_m']:g} | {r['ranks']} | {r['solver']} | {r['cells']:,} | "
                      f"{r['facets']:,} | {r['newton']} | {r['factorizations']} | {r['krylov'] or '–'} | "
-                     f"{r['repeats']} | {r['wall']:.2f} | {r['setup_s']:.2f} | {r['steps_s']:.2f} | "
+                     f"{r['repeats']} | {r['wall']:.2f} | {r['cpu']:.2f} | {r['setup_s']:.2f} | {r['steps_s']:.2f} | "
                      f"{r['output_s']:.2f} | {r['rss']:.0f} | {r['kb_per_cell'] or '–'} | {r['speedup'] or '–'} | "
                      f"{r['error']:.2g} | {r['value']:.4g} |")
     with open(args.output + ".md", "w") as f:
@@ -264,7 +271,7 @@ def write_summary(rows, path):
         if not one:
             continue
         last = one[-1]
-        summary += [(f"{key}_cells", last["cells"]), (f"{key}_wall", last["wall"]),
+        summary += [(f"{key}_cells", last["cells"]), (f"{key}_wall", last["wall"]), (f"{key}_cpu", last["cpu"]),
                     (f"{key}_rss_gb", last["rss"] / 1024), (f"{key}_error", last["error"]),
                     (f"{key}_value", last["value"]), (f"{key}_newton", last["newton"]),
                     (f"{key}_factorizations", last["factorizations"]), (f"{key}_d_m", last["d_m"])]
