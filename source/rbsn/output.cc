@@ -609,8 +609,22 @@ namespace hysteron
               rows.insert(rows.end(), {f.area, f.second_moment_1, f.second_moment_2, f.distance});
             }
           rows.insert(rows.end(), sp.k.begin(), sp.k.end());
-          rows.insert(rows.end(), sp.delta.begin(), sp.delta.end());
-          rows.insert(rows.end(), sp.force.begin(), sp.force.end());
+          // A broken facet (a crack) carries no force, as in the VTU and the probes; its
+          // deformations are the cells' relative motion now (the crack's opening), not
+          // those of the last state before it broke.
+          SpringVector delta = sp.delta, force = sp.force;
+          if (sp.broken)
+            {
+              const auto                     ld = facet_local_dofs(e);
+              std::array<double, 2 * n_dofs> U;
+              for (unsigned int k = 0; k < 2 * n_dofs; ++k)
+                U[k] = u.local_element(ld[k]);
+              for (unsigned int i = 0; i < n_dofs; ++i)
+                delta[i] = sp.deformation(i, U);
+              force.fill(0.0);
+            }
+          rows.insert(rows.end(), delta.begin(), delta.end());
+          rows.insert(rows.end(), force.begin(), force.end());
           for (unsigned int i = 0; i < n_dofs; ++i)
             rows.push_back(h1(e, i));
           rows.push_back(sp.broken ? 1 : 0);
