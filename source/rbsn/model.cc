@@ -264,6 +264,14 @@ namespace hysteron
       for (unsigned int b = 0; b < bodies.size(); ++b)
         if (!bodies[b].rigid)
           {
+            // The cells are clipped to the bodies: an unbounded one (`all`) has no network
+            // (refused here, naming the body, rather than by the sampling or the clipping).
+            for (const auto &primitive : bodies[b].shape.get_primitives())
+              require(primitive.kind != Geometry::Region<dim>::Kind::all,
+                      "Body " + bodies[b].name + "/Shape",
+                      "the shape '" + bodies[b].shape.expression() +
+                        "' contains 'all', which is unbounded: the rbsn method needs bounded "
+                        "bodies (its cells are clipped to them)");
             body_shapes.push_back(&bodies[b].shape);
             mesh_body.push_back(b);
             const auto &m = scene.material(bodies[b].material, "Body " + bodies[b].name + "/Material");
