@@ -285,6 +285,12 @@ namespace hysteron
                         "the rbsn method has no axisymmetric form (its cells are plane rigid "
                         "bodies): use Stress state = plane stress or plane strain");
               }
+            else
+              require(!bodies[b].varying_thickness() && bodies[b].thickness == 1.0,
+                      "Body " + bodies[b].name + "/Thickness",
+                      "a 3D body has no thickness (the 2D out-of-plane depth; its cells are "
+                      "volumes and its facets areas): leave it at 1 and give the body its "
+                      "depth in its Shape");
             require(m.spring_behaviour().type != Material::SpringBehaviour::Type::none,
                     "Body " + bodies[b].name + "/Material",
                     "the rbsn method's springs follow the uniaxial Bouc-Wen law: the body's "
