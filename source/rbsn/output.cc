@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <sstream>
 
 namespace hysteron
@@ -420,17 +421,24 @@ namespace hysteron
           else
             for (const auto &piece : network.cells[c].pieces)
               {
-                // VTK_POLYHEDRON: its points, and its faces as (count, then per face the
-                // number of its points and their ids).
+                // VTK_POLYHEDRON: its points, each once (its faces share them, so that its
+                // surface is closed for VTK: every edge in two faces), and its faces as
+                // (count, then per face the number of its points and their ids). The faces
+                // of a piece hold the same vertices bit for bit.
+                std::map<std::array<double, 3>, std::int64_t> ids;
                 faces.push_back(piece.size());
                 for (const auto &face : piece)
                   {
                     faces.push_back(face.size());
                     for (const auto &p : face)
                       {
-                        const std::int64_t id = add_point(p, c);
-                        faces.push_back(id);
-                        connectivity.push_back(id);
+                        const auto [at, added] = ids.try_emplace({{p[0], p[1], p[2]}}, 0);
+                        if (added)
+                          {
+                            at->second = add_point(p, c);
+                            connectivity.push_back(at->second);
+                          }
+                        faces.push_back(at->second);
                       }
                   }
                 offsets.push_back(connectivity.size());
