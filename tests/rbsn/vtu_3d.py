@@ -9,8 +9,11 @@ Components = all), static, springs.csv written. It runs on 1 rank (one .vtu per 
 2 ranks (a .pvtu and one piece per rank). For the last output of each run:
   * every VTK_POLYHEDRON (type 42) is closed: the area vectors of its faces (read from the
     "faces" stream through "faceoffsets") add up to zero (1e-12 of its area), and is
-    oriented outwards (its volume by the divergence theorem is positive); its "connectivity"
-    lists exactly the points its faces use;
+    oriented outwards (its volume by the divergence theorem is positive); it is watertight
+    for VTK: its faces share their points' ids, every edge belongs to exactly two faces, in
+    opposite directions (before the fix in output.cc every face had its own copies of its
+    points, a polygon soup to VTK); its "connectivity" lists the points its faces use, once
+    each;
   * the polyhedra's volumes add up to the body's volume, 0.24 - 16 r^2 sin(pi/16) 0.4 =
     0.2220204759 m^3 (1e-12), and their cell numbers are 0 ... n - 1, every cell at least once
     (a cell cut by the bore has several convex pieces), each in one piece only;
@@ -134,6 +137,7 @@ def check_piece(path, failures):
     if worst > 1e-15:
         failures.append(f"{name}: the displacement differs from a + w x p by {worst:.3g} m")
     polyhedra, polygons = [], []
+    open_edges = [0]
     start, face_start = 0, 0
     for k in range(n_cells):
         ids = conn[start:offsets[k]]
@@ -149,8 +153,18 @@ def check_piece(path, failures):
             if i != len(stream):
                 failures.append(f"{name}: cell {k}: its face stream has {len(stream)} entries, the faces use {i}")
             used = sorted({q for loop in loops for q in loop})
-            if used != sorted(set(ids)):
-                failures.append(f"{name}: cell {k}: connectivity and faces use different points")
+            if used != sorted(ids):
+                failures.append(f"{name}: cell {k}: its connectivity does not list the points its faces "
+                                f"use, each once")
+            # Watertight and consistently oriented: every edge (a, b) of a face is the edge
+            # (b, a) of exactly one other face (the faces share their points' ids).
+            edges = {}
+            for loop in loops:
+                for j in range(len(loop)):
+                    edge = (loop[j], loop[(j + 1) % len(loop)])
+                    edges[edge] = edges.get(edge, 0) + 1
+            if any(n != 1 or edges.get((b, a), 0) != 1 for (a, b), n in edges.items()):
+                open_edges[0] += 1
             vectors = [area_vector([P[q] for q in loop]) for loop in loops]
             total = [sum(v[i] for v in vectors) for i in range(3)]
             surface = sum(norm(v) for v in vectors)
@@ -173,6 +187,9 @@ def check_piece(path, failures):
             polygons.append((facet[k], norm(area_vector([P[q] for q in ids]))))
         else:
             failures.append(f"{name}: cell {k} has VTK type {types[k]}")
+    if open_edges[0]:
+        failures.append(f"{name}: {open_edges[0]} of {len(polyhedra)} polyhedra are not watertight (an edge "
+                        f"not shared by exactly two faces in opposite directions)")
     return polyhedra, polygons
 
 
