@@ -15,12 +15,13 @@ Two scenes at growing cell counts, each run --repeats times (median), pinned to 
     Error: the load at 50 mm against P_u = 30 kN. Target: 10,000 cells in under 60 s.
 
 The largest network of each scene also runs on 2 MPI ranks (both cores, not pinned; one run), with
-each distributed solver (UMFPACK gathered on rank 0, Amesos KLU and MUMPS); the 1-rank runs use
-UMFPACK.
+each distributed solver (UMFPACK gathered on rank 0, Amesos KLU and MUMPS), and on 1 and 2 ranks
+with the iterative solvers (cg for the plate, gmres for the cantilever, with algebraic multigrid),
+which show the memory of the distributed network per rank; the other 1-rank runs use UMFPACK.
 
 Time: the whole process (MPI start-up, set-up, steps, output), measured around the call, and
 hysteron's own timer sections (set-up, steps, output) of the median run. Memory: the peak
-resident set (/usr/bin/time); per cell, the slope between the two largest runs of a scene (the
+resident set of each rank (/usr/bin/time inside mpirun); per cell, the slope between the two largest runs of a scene (the
 libraries' fixed ~100 MB drop out). Writes CSV and Markdown to --output (default
 doc/benchmarks/rbsn_large).
 
@@ -51,9 +52,13 @@ def run(hysteron, directory, text, ranks=1):
     with open(os.path.join(directory, "scene.prm"), "w") as f:
         f.write(text)
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    command = ["/usr/bin/time", "-f", "RSS %M", hysteron, "scene.prm"]
+    rss_file = os.path.join(directory, "peak_rss.txt")
+    if os.path.exists(rss_file):
+        os.remove(rss_file)
+    # GNU time inside mpirun: one peak resident set per rank.
+    command = ["/usr/bin/time", "-a", "-o", rss_file, "-f", "RSS %M", hysteron, "scene.prm"]
     if ranks > 1:
-        command = ["/usr/bin/time", "-f", "RSS %M", "mpirun", "-np", str(ranks), hysteron, "scene.prm"]
+        command = ["mpirun", "-np", str(ranks)] + command
     elif shutil.which("taskset"):
         command = ["taskset", "-c", "1"] + command
     start = time.perf_counter()
@@ -67,8 +72,8 @@ def run(hysteron, directory, text, ranks=1):
     sections = dict(setup_s=0.0, steps_s=0.0, output_s=0.0)
     for name, seconds in re.findall(r"\|\s*(set-up|steps|output)\s*\|\s*\d+\s*\|\s*([0-9.]+)s", p.stdout):
         sections[names[name]] = float(seconds)
-    rss = float(re.search(r"RSS (\d+)", p.stderr).group(1)) / 1024
-    return dict(wall=wall, rss=rss, cells=int(m.group(1)), facets=int(m.group(2)), steps=int(m.group(3)),
+    per_rank = [float(v) / 1024 for v in re.findall(r"RSS (\d+)", open(rss_file).read())]
+    return dict(wall=wall, rss=max(per_rank), rss_per_rank=per_rank, cells=int(m.group(1)), facets=int(m.group(2)), steps=int(m.group(3)),
                 newton=int(m.group(4)), factorizations=int(m.group(5)), **sections)
 
 
@@ -78,16 +83,25 @@ def median_run(hysteron, directory, text, repeats, ranks=1):
 
 
 def label(ranks, solver):
-    """The solver column: UMFPACK on one rank; under MPI the distributed solver."""
+    """The solver column: UMFPACK on one rank; under MPI the distributed solver; cg / gmres + AMG."""
+    if solver in ("cg", "gmres"):
+        return solver + " + AMG"
     if ranks == 1:
         return "UMFPACK"
     return "UMFPACK on rank 0" if solver == "UMFPACK" else solver
 
 
+def solver_entries(solver):
+    """The RBSN entries that choose @p solver."""
+    if solver in ("cg", "gmres"):
+        return f"  set Linear solver = {solver}"
+    return f"  set Distributed direct solver = {solver}"
+
+
 def plate(hysteron, work, d_m, repeats, ranks=1, solver="UMFPACK"):
     with open(os.path.join(ROOT, "benchmarks", "rbsn", "plate_uniaxial.prm")) as f:
         text = set_entry(f.read(), "Minimum distance", d_m)
-    text = text.replace("  set Analysis = static", f"  set Analysis = static\n  set Distributed direct solver = {solver}")
+    text = text.replace("  set Analysis = static", "  set Analysis = static\n" + solver_entries(solver))
     d = os.path.join(work, f"plate_{d_m:g}_{ranks}_{solver}")
     r = median_run(hysteron, d, text, repeats, ranks)
     error = 0.0
@@ -108,7 +122,7 @@ def cantilever(hysteron, work, d_m, repeats, ranks=1, solver="UMFPACK"):
     with open(os.path.join(ROOT, "prm", "rbsn_cantilever_plastic.prm")) as f:
         text = f.read()
     text = set_entry(text, "Minimum distance", d_m)
-    text = text.replace("  set Spring law = coupled", f"  set Spring law = coupled\n  set Distributed direct solver = {solver}")
+    text = text.replace("  set Spring law = coupled", "  set Spring law = coupled\n" + solver_entries(solver))
     text = set_entry(text, "Additional points", end_points(d_m, 0, 0.1))
     text = set_entry(text, "Write VTU", "false")
     d = os.path.join(work, f"cantilever_{d_m:g}_{ranks}_{solver}")
@@ -145,11 +159,17 @@ def main():
             print(rows[-1], flush=True)
             rows.append(cantilever(hysteron, work, cantilever_dm[-1], 1, 2, solver))
             print(rows[-1], flush=True)
+        # The distributed network with the distributed iterative solvers: the memory per rank.
+        for ranks in (1, 2):
+            rows.append(plate(hysteron, work, plate_dm[-1], 1, ranks, "cg"))
+            print(rows[-1], flush=True)
+            rows.append(cantilever(hysteron, work, cantilever_dm[-1], 1, ranks, "gmres"))
+            print(rows[-1], flush=True)
     # Memory per cell: the slope of the peak RSS between the two largest runs of each scene.
     for r in rows:
         r["kb_per_cell"] = ""
     for scene in dict.fromkeys(r["scene"] for r in rows):
-        runs = [r for r in rows if r["scene"] == scene and r["ranks"] == 1]
+        runs = [r for r in rows if r["scene"] == scene and r["ranks"] == 1 and r["solver"] == "UMFPACK"]
         for r in runs:
             r["kb_per_cell"] = ""
         if len(runs) >= 2:
@@ -164,12 +184,12 @@ def main():
         for r in rows:
             w.writerow({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in r.items()})
     header = ("| scene | d_m [m] | ranks | solver | cells | facets | Newton iterations | factorizations | total [s] | set-up [s] "
-              "| steps [s] | output [s] | peak RSS [MB] | memory per cell [kB] | error | second value |")
+              "| steps [s] | output [s] | peak RSS per rank [MB] | memory per cell [kB] | error | second value |")
     lines = [header, "|" + "---|" * (header.count("|") - 1)]
     for r in rows:
         lines.append(f"| {r['scene']} | {r['d_m']:g} | {r['ranks']} | {r['solver']} | {r['cells']:,} | {r['facets']:,} | {r['newton']} | "
                      f"{r['factorizations']} | {r['wall']:.2f} | {r['setup_s']:.2f} | {r['steps_s']:.2f} | "
-                     f"{r['output_s']:.2f} | {r['rss']:.0f} | {r['kb_per_cell'] or '–'} | {r['error']:.2g} | "
+                     f"{r['output_s']:.2f} | {', '.join(f'{m:.0f}' for m in r['rss_per_rank'])} | {r['kb_per_cell'] or '–'} | {r['error']:.2g} | "
                      f"{r['value']:.4g} |")
     with open(args.output + ".md", "w") as f:
         f.write("\n".join(lines) + "\n")

@@ -264,6 +264,14 @@ namespace hysteron
       for (unsigned int b = 0; b < bodies.size(); ++b)
         if (!bodies[b].rigid)
           {
+            // The cells are clipped to the bodies: an unbounded one (`all`) has no network
+            // (refused here, naming the body, rather than by the sampling or the clipping).
+            for (const auto &primitive : bodies[b].shape.get_primitives())
+              require(primitive.kind != Geometry::Region<dim>::Kind::all,
+                      "Body " + bodies[b].name + "/Shape",
+                      "the shape '" + bodies[b].shape.expression() +
+                        "' contains 'all', which is unbounded: the rbsn method needs bounded "
+                        "bodies (its cells are clipped to them)");
             body_shapes.push_back(&bodies[b].shape);
             mesh_body.push_back(b);
             const auto &m = scene.material(bodies[b].material, "Body " + bodies[b].name + "/Material");
@@ -277,6 +285,12 @@ namespace hysteron
                         "the rbsn method has no axisymmetric form (its cells are plane rigid "
                         "bodies): use Stress state = plane stress or plane strain");
               }
+            else
+              require(!bodies[b].varying_thickness() && bodies[b].thickness == 1.0,
+                      "Body " + bodies[b].name + "/Thickness",
+                      "a 3D body has no thickness (the 2D out-of-plane depth; its cells are "
+                      "volumes and its facets areas): leave it at 1 and give the body its "
+                      "depth in its Shape");
             require(m.spring_behaviour().type != Material::SpringBehaviour::Type::none,
                     "Body " + bodies[b].name + "/Material",
                     "the rbsn method's springs follow the uniaxial Bouc-Wen law: the body's "

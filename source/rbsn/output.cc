@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <sstream>
 
 namespace hysteron
@@ -420,17 +421,24 @@ namespace hysteron
           else
             for (const auto &piece : network.cells[c].pieces)
               {
-                // VTK_POLYHEDRON: its points, and its faces as (count, then per face the
-                // number of its points and their ids).
+                // VTK_POLYHEDRON: its points, each once (its faces share them, so that its
+                // surface is closed for VTK: every edge in two faces), and its faces as
+                // (count, then per face the number of its points and their ids). The faces
+                // of a piece hold the same vertices bit for bit.
+                std::map<std::array<double, 3>, std::int64_t> ids;
                 faces.push_back(piece.size());
                 for (const auto &face : piece)
                   {
                     faces.push_back(face.size());
                     for (const auto &p : face)
                       {
-                        const std::int64_t id = add_point(p, c);
-                        faces.push_back(id);
-                        connectivity.push_back(id);
+                        const auto [at, added] = ids.try_emplace({{p[0], p[1], p[2]}}, 0);
+                        if (added)
+                          {
+                            at->second = add_point(p, c);
+                            connectivity.push_back(at->second);
+                          }
+                        faces.push_back(at->second);
                       }
                   }
                 offsets.push_back(connectivity.size());
@@ -609,8 +617,22 @@ namespace hysteron
               rows.insert(rows.end(), {f.area, f.second_moment_1, f.second_moment_2, f.distance});
             }
           rows.insert(rows.end(), sp.k.begin(), sp.k.end());
-          rows.insert(rows.end(), sp.delta.begin(), sp.delta.end());
-          rows.insert(rows.end(), sp.force.begin(), sp.force.end());
+          // A broken facet (a crack) carries no force, as in the VTU and the probes; its
+          // deformations are the cells' relative motion now (the crack's opening), not
+          // those of the last state before it broke.
+          SpringVector delta = sp.delta, force = sp.force;
+          if (sp.broken)
+            {
+              const auto                     ld = facet_local_dofs(e);
+              std::array<double, 2 * n_dofs> U;
+              for (unsigned int k = 0; k < 2 * n_dofs; ++k)
+                U[k] = u.local_element(ld[k]);
+              for (unsigned int i = 0; i < n_dofs; ++i)
+                delta[i] = sp.deformation(i, U);
+              force.fill(0.0);
+            }
+          rows.insert(rows.end(), delta.begin(), delta.end());
+          rows.insert(rows.end(), force.begin(), force.end());
           for (unsigned int i = 0; i < n_dofs; ++i)
             rows.push_back(h1(e, i));
           rows.push_back(sp.broken ? 1 : 0);

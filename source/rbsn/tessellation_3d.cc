@@ -324,13 +324,19 @@ namespace hysteron
 
       /**
        * Forbidden balls that keep random nuclei from owning any of the boundary where
-       * the fixed points cover it. A point p owns a piece of a face near x if it is
-       * closer to x than the face's nuclei are, |p - x| < rho(x); the union of those
-       * balls B(x, rho(x)) over a face is the union of the empty circumballs of the
-       * Delaunay triangles of the face's nuclei (rho is largest at the circumcentres,
-       * and the condition is linear in x between them). Balls whose circumcentre lies
-       * on the face and whose radius is below 1.25 d (a saturated face; sparse user
-       * points are left alone) are returned.
+       * the fixed points cover it. A point p owns the boundary point x if it is closer
+       * to x than every fixed point, |p - x| < rho(x) = min_q |x - q|. On a boundary
+       * polygon F, the part R_q of F nearest to the fixed point q (F clipped by the
+       * bisector planes of q and the other fixed points: a convex polygon) has
+       * |p - x|^2 - |q - x|^2 affine in x, so p is closer than q to a point of R_q iff
+       * it is to a vertex v of R_q. The union of the balls B(x, rho(x)) over the
+       * boundary is therefore the union of the balls B(v, |v - q|) over the vertices of
+       * these restricted Voronoi regions: the circumcentres of the fixed points in a
+       * face, and where the regions meet the polygons' edges and corners. This holds
+       * for any polyhedral boundary: the faces of a box, and the narrow sides of a prism
+       * or the small triangles of a geodesic sphere, which hold too few fixed points of
+       * their own for a Delaunay triangulation in their plane. Balls of radius below
+       * 1.25 d(v) are returned (a saturated surface; sparse user points are left alone).
        */
       std::vector<std::pair<Point, double>>
       boundary_balls(const Polyhedral::Domain                       &domain,
@@ -338,67 +344,103 @@ namespace hysteron
                      const std::vector<Point>                       &fixed,
                      const Spacing<3>                               &d)
       {
-        using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-        using Vb     = CGAL::Triangulation_vertex_base_with_info_2<unsigned int, Kernel>;
-        using Tds    = CGAL::Triangulation_data_structure_2<Vb>;
-        using DT     = CGAL::Delaunay_triangulation_2<Kernel, Tds>;
         std::vector<std::pair<Point, double>> balls;
-        if (fixed.size() < 3)
+        if (fixed.empty())
           return balls;
-        const auto   groups    = face_groups(polygons);
-        const double tolerance = 1e-9 * domain.scale;
-        std::vector<unsigned int> group_of(polygons.size());
-        std::vector<Box>          boxes;
-        for (unsigned int g = 0; g < groups.size(); ++g)
-          for (const unsigned int k : groups[g].polygons)
-            group_of[k] = g;
-        for (const auto &b : polygons)
-          boxes.push_back(b.polygon.bounding_box());
-        Polyhedral::BoxTree tree;
-        tree.build(boxes);
-        std::vector<std::vector<unsigned int>> members(groups.size());
-        std::vector<unsigned int>              found;
+        // Only vertices within reach = 1.25 d_max of their q give balls, and a fixed
+        // point q' cuts such a vertex off R_q only if |q' - q| < 2 reach.
+        const double reach = 1.25 * d.max;
+        using Key          = std::array<long long, 3>;
+        const auto key     = [&](const Point &p) {
+          return Key{{static_cast<long long>(std::floor(p[0] / reach)), static_cast<long long>(std::floor(p[1] / reach)),
+                      static_cast<long long>(std::floor(p[2] / reach))}};
+        };
+        std::map<Key, std::vector<unsigned int>> grid;
         for (unsigned int i = 0; i < fixed.size(); ++i)
+          grid[key(fixed[i])].push_back(i);
+        const auto within = [&](const Point &lo, const Point &hi, std::vector<unsigned int> &result) {
+          result.clear();
+          const Key a = key(lo), b = key(hi);
+          for (long long z = a[2]; z <= b[2]; ++z)
+            for (long long y = a[1]; y <= b[1]; ++y)
+              for (long long x = a[0]; x <= b[0]; ++x)
+                if (const auto g = grid.find(Key{{x, y, z}}); g != grid.end())
+                  result.insert(result.end(), g->second.begin(), g->second.end());
+        };
+        // The fixed points within 2 reach of each q, nearest first (computed when needed).
+        std::vector<std::vector<unsigned int>> neighbours(fixed.size());
+        std::vector<bool>                      listed(fixed.size(), false);
+        std::vector<unsigned int>              found;
+        const auto                             neighbours_of = [&](const unsigned int q) -> const std::vector<unsigned int> & {
+          if (!listed[q])
+            {
+              const Vector r({2 * reach, 2 * reach, 2 * reach});
+              within(fixed[q] - r, fixed[q] + r, found);
+              auto &list = neighbours[q];
+              for (const unsigned int k : found)
+                if (k != q && fixed[k].distance(fixed[q]) < 2 * reach && fixed[k].distance(fixed[q]) > domain.tolerance)
+                  list.push_back(k);
+              std::sort(list.begin(), list.end(), [&](const unsigned int a, const unsigned int b) {
+                const double da = fixed[a].distance_square(fixed[q]), db = fixed[b].distance_square(fixed[q]);
+                return da < db || (da == db && a < b);
+              });
+              listed[q] = true;
+            }
+          return neighbours[q];
+        };
+        Polyhedral::Clipper       clipper(domain.tolerance);
+        Polyhedral::ConvexPolygon region, clipped;
+        std::vector<unsigned int> candidates;
+        for (const auto &b : polygons)
           {
-            Box b;
-            b.add(fixed[i]);
-            found.clear();
-            tree.query(b, tolerance, found);
-            for (const unsigned int k : found)
-              if (on_polygon(polygons[k].polygon, fixed[i], tolerance) &&
-                  (members[group_of[k]].empty() || members[group_of[k]].back() != i))
-                members[group_of[k]].push_back(i);
-          }
-        for (unsigned int g = 0; g < groups.size(); ++g)
-          {
-            if (members[g].size() < 3)
-              continue;
-            const auto  &first = polygons[groups[g].polygons[0]].polygon;
-            const Vector n = first.normal, e1 = Polyhedral::perpendicular(n), e2 = cross_product_3d(n, e1);
-            const Point  o = first.vertices[0];
-            std::vector<std::pair<Kernel::Point_2, unsigned int>> input;
-            for (const unsigned int i : members[g])
-              input.emplace_back(Kernel::Point_2((fixed[i] - o) * e1, (fixed[i] - o) * e2), i);
-            DT dt;
-            dt.insert(input.begin(), input.end());
-            if (dt.dimension() < 2)
-              continue;
-            for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f)
+            // The fixed points within reach of the polygon's box.
+            const Box    box = b.polygon.bounding_box();
+            const Vector r({reach, reach, reach});
+            within(box.lo - r, box.hi + r, candidates);
+            std::sort(candidates.begin(), candidates.end());
+            for (const unsigned int q : candidates)
               {
-                const auto  &a = f->vertex(0)->point(), &b = f->vertex(1)->point(), &c = f->vertex(2)->point();
-                const double bx = b.x() - a.x(), by = b.y() - a.y(), cx = c.x() - a.x(), cy = c.y() - a.y();
-                const double D = 2 * (bx * cy - by * cx);
-                if (std::abs(D) <= 1e-300)
+                double gap = 0; // the distance of q from the box
+                for (unsigned int k = 0; k < 3; ++k)
+                  gap += std::pow(std::max({box.lo[k] - fixed[q][k], fixed[q][k] - box.hi[k], 0.0}), 2);
+                if (gap >= reach * reach)
                   continue;
-                const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
-                const double ux = (cy * b2 - by * c2) / D, uy = (bx * c2 - cx * b2) / D;
-                const double R  = std::sqrt(ux * ux + uy * uy);
-                const Point  centre = o + (a.x() + ux) * e1 + (a.y() + uy) * e2;
-                bool         on     = false;
-                for (const unsigned int k : groups[g].polygons)
-                  on = on || on_polygon(polygons[k].polygon, centre, tolerance);
-                if (on && R < 1.25 * d(centre))
-                  balls.emplace_back(centre, R);
+                region      = b.polygon;
+                bool  empty = false;
+                const auto farthest = [&]() {
+                  double rho = 0;
+                  for (const auto &v : region.vertices)
+                    rho = std::max(rho, v.distance(fixed[q]));
+                  return rho;
+                };
+                double rho_max = farthest();
+                for (const unsigned int k : neighbours_of(q))
+                  {
+                    const Vector e = fixed[k] - fixed[q];
+                    const double h = e.norm();
+                    if (h > 2 * rho_max)
+                      break; // its bisector misses the region (and so do the farther ones')
+                    const Polyhedral::Plane bisector{e / h, (e / h) * (0.5 * (fixed[q] + fixed[k]))};
+                    const auto              cut = clipper.clip(region, bisector, 0, clipped);
+                    if (cut == Polyhedral::Cut::outside)
+                      {
+                        empty = true;
+                        break;
+                      }
+                    if (cut == Polyhedral::Cut::cut)
+                      {
+                        region.vertices.swap(clipped.vertices);
+                        rho_max = farthest();
+                      }
+                  }
+                if (empty)
+                  continue;
+                for (const auto &v : region.vertices)
+                  {
+                    const double rho = v.distance(fixed[q]);
+                    if (rho > domain.tolerance && rho < 1.25 * d(v))
+                      balls.emplace_back(v, rho);
+                  }
               }
           }
         return balls;

@@ -108,10 +108,11 @@ namespace hysteron
      * pass the one given to voronoi() so that every point lies in its domain). The
      * front grows on the unit sphere's directions at radii [d, 2 d]; the gaps are
      * swept with darts per uncovered cube of side d_min / sqrt(3), then per eighth of
-     * it for 2 levels. Fixed points on the domain's boundary own it: where they cover
-     * a face (the empty circumcircles of their Delaunay triangles in the face, radius
-     * below 1.25 d), no random point is put within a circumball, so that no random
-     * point's cell reaches that face. Throws InputError(@p where) unless d > 0, for an
+     * it for 2 levels. Fixed points own the domain's boundary: where they cover it
+     * (rho(x), the distance of a boundary point x from the nearest fixed point, below
+     * 1.25 d), no random point comes closer to x than rho(x), so that no random point's
+     * cell reaches the boundary (the balls B(v, rho(v)) at the vertices of the fixed
+     * points' Voronoi regions restricted to every boundary polygon). Throws InputError(@p where) unless d > 0, for an
      * unbounded body (`all`), and for more than 5e6 points predicted (density V / d^3
      * for a constant d, d.predicted_points otherwise).
      */
