@@ -85,28 +85,6 @@ namespace hysteron
 
 
 
-      Box
-      ConvexPolyhedron::bounding_box() const
-      {
-        Box b;
-        for (const auto &v : vertices)
-          b.add(v);
-        return b;
-      }
-
-
-
-      Point
-      ConvexPolyhedron::vertex_mean() const
-      {
-        Vector s;
-        for (const auto &v : vertices)
-          s += v;
-        return Point(s / static_cast<double>(vertices.size()));
-      }
-
-
-
       std::vector<Point>
       ConvexPolyhedron::face(const unsigned int f) const
       {
@@ -114,28 +92,6 @@ namespace hysteron
         for (unsigned int k = face_start[f]; k < face_start[f + 1]; ++k)
           loop.push_back(vertices[face_vertices[k]]);
         return loop;
-      }
-
-
-
-      Box
-      ConvexPolygon::bounding_box() const
-      {
-        Box b;
-        for (const auto &v : vertices)
-          b.add(v);
-        return b;
-      }
-
-
-
-      Point
-      ConvexPolygon::vertex_mean() const
-      {
-        Vector s;
-        for (const auto &v : vertices)
-          s += v;
-        return Point(s / static_cast<double>(vertices.size()));
       }
 
 

@@ -88,6 +88,26 @@ namespace hysteron
         }
       };
 
+      /// The bounding box of a set of points.
+      inline Box
+      bounding_box(const std::vector<Point> &points)
+      {
+        Box b;
+        for (const auto &p : points)
+          b.add(p);
+        return b;
+      }
+
+      /// The mean of a non-empty set of points (inside their convex hull).
+      inline Point
+      mean(const std::vector<Point> &points)
+      {
+        Vector s;
+        for (const auto &p : points)
+          s += p;
+        return Point(s / static_cast<double>(points.size()));
+      }
+
       /**
        * Face tags: a Voronoi neighbour j >= 0, the starting box (-1), or plane p of
        * the domain, as given (its half-space) or flipped (the complement's).
@@ -155,11 +175,17 @@ namespace hysteron
         make_box(const Point &lo, const Point &hi, const int tag);
 
         Box
-        bounding_box() const;
+        bounding_box() const
+        {
+          return Polyhedral::bounding_box(vertices);
+        }
 
         /// The mean of the vertices (a point inside).
         Point
-        vertex_mean() const;
+        vertex_mean() const
+        {
+          return mean(vertices);
+        }
 
         /// Face @p f as a loop of points.
         std::vector<Point>
@@ -179,10 +205,16 @@ namespace hysteron
         }
 
         Box
-        bounding_box() const;
+        bounding_box() const
+        {
+          return Polyhedral::bounding_box(vertices);
+        }
 
         Point
-        vertex_mean() const;
+        vertex_mean() const
+        {
+          return mean(vertices);
+        }
       };
 
       /// Where a convex set lies with respect to a plane.

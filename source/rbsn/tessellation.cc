@@ -3,6 +3,8 @@
 #include <hysteron/base/exceptions.h>
 #include <hysteron/rbsn/tessellation.h>
 
+#include "rbsn/sampling.h"
+
 // CGAL's headers are not warning-clean under -Wall -Wextra.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-parameter"
@@ -27,27 +29,13 @@ namespace hysteron
     {
       using Point   = dealii::Point<2>;
       using Segment = std::array<Point, 2>;
+      using Sampling::text;
+      using Sampling::uniform;
 
       double
       cross(const dealii::Tensor<1, 2> &a, const dealii::Tensor<1, 2> &b)
       {
         return a[0] * b[1] - a[1] * b[0];
-      }
-
-      /// A uniform double in [0, 1) from the top 53 bits (the same on every platform).
-      double
-      uniform(std::mt19937_64 &rng)
-      {
-        return (rng() >> 11) * (1.0 / 9007199254740992.0);
-      }
-
-      std::string
-      text(const Point &p)
-      {
-        std::ostringstream s;
-        s.precision(10);
-        s << "(" << p[0] << ", " << p[1] << ")";
-        return s.str();
       }
 
       /**
@@ -433,33 +421,20 @@ namespace hysteron
       // Bridson: grow from active points by trial points in the annulus [d, 2 d]
       // around them until the front dies out.
       std::mt19937_64 rng(seed);
-      const auto      grow = [&]() {
-        while (!active.empty())
-          {
-            const unsigned int pick = static_cast<unsigned int>(uniform(rng) * active.size());
-            const Point        c    = points[active[pick]];
-            const double       dc   = radius[active[pick]];
-            bool               grew = false;
-            for (unsigned int attempt = 0; attempt < 30 && !grew; ++attempt)
-              {
-                const double r = dc * (1 + uniform(rng)), phi = 2 * M_PI * uniform(rng);
-                const Point  p(c[0] + r * std::cos(phi), c[1] + r * std::sin(phi));
-                double       dp;
-                if (free(p, dp))
-                  {
-                    active.push_back(points.size());
-                    add(p, dp);
-                    result.push_back(p);
-                    grew = true;
-                  }
-              }
-            if (!grew)
-              {
-                active[pick] = active.back();
-                active.pop_back();
-              }
-          }
+      const auto      try_add = [&](const Point &p) {
+        double dp;
+        if (!free(p, dp))
+          return false;
+        active.push_back(points.size());
+        add(p, dp);
+        result.push_back(p);
+        return true;
       };
+      const auto annulus = [&](const Point &c, const double dc) {
+        const double r = dc * (1 + uniform(rng)), phi = 2 * M_PI * uniform(rng);
+        return Point(c[0] + r * std::cos(phi), c[1] + r * std::sin(phi));
+      };
+      const auto grow = [&]() { Sampling::grow_front(active, points, radius, rng, annulus, try_add); };
       grow();
       // A square [x0, x0 + size] x [y0, y0 + size] in which every trial is refused
       // because one point's disk of radius d(q) / (1 + L) holds its four corners.
@@ -483,20 +458,13 @@ namespace hysteron
       const auto darts = [&](const double x0, const double y0, const double size, const unsigned int trials) {
         const double ax = std::max(x0, box.first[0]), bx = std::min(x0 + size, box.second[0]);
         const double ay = std::max(y0, box.first[1]), by = std::min(y0 + size, box.second[1]);
-        for (unsigned int attempt = 0; attempt < trials && ax <= bx && ay <= by; ++attempt)
-          {
-            const double u = uniform(rng), v = uniform(rng);
-            const Point  p(ax + u * (bx - ax), ay + v * (by - ay));
-            double       dp;
-            if (free(p, dp))
-              {
-                active.push_back(points.size());
-                add(p, dp);
-                result.push_back(p);
-                grow();
-                return;
-              }
-          }
+        if (ax > bx || ay > by)
+          return;
+        const auto draw = [&]() {
+          const double u = uniform(rng), v = uniform(rng);
+          return Point(ax + u * (bx - ax), ay + v * (by - ay));
+        };
+        Sampling::throw_darts(trials, draw, try_add, grow);
       };
       // The gaps the front left (other components, the first seed, corners): 30
       // trials in every grid cell that no exclusion disk covers, in a fixed order,

@@ -2,6 +2,7 @@
 #include <hysteron/rbsn/tessellation.h>
 
 #include "rbsn/polyhedron.h"
+#include "rbsn/sampling.h"
 
 // CGAL's headers are not warning-clean under -Wall -Wextra.
 #pragma GCC diagnostic push
@@ -32,22 +33,8 @@ namespace hysteron
       using Polyhedral::Point;
       using Polyhedral::Vector;
       using Point2 = std::array<double, 2>;
-
-      /// A uniform double in [0, 1) from the top 53 bits (the same on every platform).
-      double
-      uniform(std::mt19937_64 &rng)
-      {
-        return (rng() >> 11) * (1.0 / 9007199254740992.0);
-      }
-
-      std::string
-      text(const Point &p)
-      {
-        std::ostringstream s;
-        s.precision(10);
-        s << "(" << p[0] << ", " << p[1] << ", " << p[2] << ")";
-        return s.str();
-      }
+      using Sampling::text;
+      using Sampling::uniform;
 
       /// Whether x lies on the convex polygon (within @p tolerance of its plane and edges).
       bool
@@ -583,37 +570,22 @@ namespace hysteron
         active.push_back(k);
       std::vector<Point> result;
       std::mt19937_64    rng(seed);
-      const auto         accept = [&](const Point &p, const double dp) {
+      const auto         try_add = [&](const Point &p) {
+        double dp;
+        if (!grid.free(p, dp, in_domain))
+          return false;
         active.push_back(grid.points.size());
         grid.add(p, dp);
         result.push_back(p);
+        return true;
       };
-      const auto grow = [&]() {
-        while (!active.empty())
-          {
-            const unsigned int pick = static_cast<unsigned int>(uniform(rng) * active.size());
-            const Point        c    = grid.points[active[pick]];
-            const double       dc   = grid.radius[active[pick]];
-            bool               grew = false;
-            for (unsigned int attempt = 0; attempt < 30 && !grew; ++attempt)
-              {
-                const double r = dc * (1 + uniform(rng)), z = 2 * uniform(rng) - 1, phi = 2 * M_PI * uniform(rng);
-                const double s = std::sqrt(std::max(0.0, 1 - z * z));
-                const Point  p(c[0] + r * s * std::cos(phi), c[1] + r * s * std::sin(phi), c[2] + r * z);
-                double       dp;
-                if (grid.free(p, dp, in_domain))
-                  {
-                    accept(p, dp);
-                    grew = true;
-                  }
-              }
-            if (!grew)
-              {
-                active[pick] = active.back();
-                active.pop_back();
-              }
-          }
+      // Uniform directions: z = cos(theta) uniform in [-1, 1], phi in [0, 2 pi).
+      const auto shell = [&](const Point &c, const double dc) {
+        const double r = dc * (1 + uniform(rng)), z = 2 * uniform(rng) - 1, phi = 2 * M_PI * uniform(rng);
+        const double s = std::sqrt(std::max(0.0, 1 - z * z));
+        return Point(c[0] + r * s * std::cos(phi), c[1] + r * s * std::sin(phi), c[2] + r * z);
       };
+      const auto grow = [&]() { Sampling::grow_front(active, grid.points, grid.radius, rng, shell, try_add); };
       grow();
       // Up to @p trials random points in a cube (its part in the domain's box); the
       // first that is free is added and the front grows from it.
@@ -626,18 +598,11 @@ namespace hysteron
             if (a[k] > b[k])
               return;
           }
-        for (unsigned int attempt = 0; attempt < trials; ++attempt)
-          {
-            const double u = uniform(rng), v = uniform(rng), w = uniform(rng);
-            const Point  p(a[0] + u * (b[0] - a[0]), a[1] + v * (b[1] - a[1]), a[2] + w * (b[2] - a[2]));
-            double       dp;
-            if (grid.free(p, dp, in_domain))
-              {
-                accept(p, dp);
-                grow();
-                return;
-              }
-          }
+        const auto draw = [&]() {
+          const double u = uniform(rng), v = uniform(rng), w = uniform(rng);
+          return Point(a[0] + u * (b[0] - a[0]), a[1] + v * (b[1] - a[1]), a[2] + w * (b[2] - a[2]));
+        };
+        Sampling::throw_darts(trials, draw, try_add, grow);
       };
       const auto cube_covered = [&](const Point &corner, const double size) {
         Point corners[8];
@@ -908,36 +873,28 @@ namespace hysteron
           for (const unsigned int k : found)
             if (std::abs(n * (grid.points[k] - o)) <= match && on_face(to_plane(grid.points[k]), match))
               active.push_back(k);
-          const auto accept = [&](const Point &p, const double dp) {
+          const auto anywhere = [](const Point &) { return true; };
+          // A point q of the plane, if free (the darts are drawn on the face).
+          const auto try_add = [&](const Point2 &q) {
+            double      dp;
+            const Point p = to_space(q);
+            if (!grid.free(p, dp, anywhere))
+              return false;
             active.push_back(grid.points.size());
             grid.add(p, dp);
             points.push_back(p);
+            return true;
           };
-          const auto anywhere = [](const Point &) { return true; };
-          const auto grow     = [&]() {
-            while (!active.empty())
-              {
-                const unsigned int pick = static_cast<unsigned int>(uniform(rng) * active.size());
-                const Point2       c    = to_plane(grid.points[active[pick]]);
-                const double       dc   = grid.radius[active[pick]];
-                bool               grew = false;
-                for (unsigned int attempt = 0; attempt < 30 && !grew; ++attempt)
-                  {
-                    const double r = dc * (1 + uniform(rng)), phi = 2 * M_PI * uniform(rng);
-                    const Point2 q{{c[0] + r * std::cos(phi), c[1] + r * std::sin(phi)}};
-                    double       dp;
-                    if (on_face(q, 0) && grid.free(to_space(q), dp, anywhere))
-                      {
-                        accept(to_space(q), dp);
-                        grew = true;
-                      }
-                  }
-                if (!grew)
-                  {
-                    active[pick] = active.back();
-                    active.pop_back();
-                  }
-              }
+          // The front's trials are drawn in the annulus about c in the plane, and
+          // must lie on the face.
+          const auto annulus = [&](const Point &c3, const double dc) {
+            const Point2 c = to_plane(c3);
+            const double r = dc * (1 + uniform(rng)), phi = 2 * M_PI * uniform(rng);
+            return Point2{{c[0] + r * std::cos(phi), c[1] + r * std::sin(phi)}};
+          };
+          const auto try_add_on_face = [&](const Point2 &q) { return on_face(q, 0) && try_add(q); };
+          const auto grow            = [&]() {
+            Sampling::grow_front(active, grid.points, grid.radius, rng, annulus, try_add_on_face);
           };
           grow();
           // Darts uniformly over the part of the face in a square (its fan triangles).
@@ -961,29 +918,23 @@ namespace hysteron
               }
             if (triangles.empty())
               return false;
-            for (unsigned int attempt = 0; attempt < trials; ++attempt)
-              {
-                const double pick = uniform(rng) * total;
-                const auto   t    = std::min<std::size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), pick) -
-                                                           cumulative.begin(),
-                                                         triangles.size() - 1);
-                double u = uniform(rng), v = uniform(rng);
-                if (u + v > 1)
-                  {
-                    u = 1 - u;
-                    v = 1 - v;
-                  }
-                const auto  &T = triangles[t];
-                const Point2 q{{T[0][0] + u * (T[1][0] - T[0][0]) + v * (T[2][0] - T[0][0]),
-                                T[0][1] + u * (T[1][1] - T[0][1]) + v * (T[2][1] - T[0][1])}};
-                double       dp;
-                if (grid.free(to_space(q), dp, anywhere))
-                  {
-                    accept(to_space(q), dp);
-                    grow();
-                    break;
-                  }
-              }
+            // A triangle by area, then a uniform point in it (folded barycentrics).
+            const auto draw = [&]() {
+              const double pick = uniform(rng) * total;
+              const auto   t    = std::min<std::size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), pick) -
+                                                       cumulative.begin(),
+                                                     triangles.size() - 1);
+              double u = uniform(rng), v = uniform(rng);
+              if (u + v > 1)
+                {
+                  u = 1 - u;
+                  v = 1 - v;
+                }
+              const auto &T = triangles[t];
+              return Point2{{T[0][0] + u * (T[1][0] - T[0][0]) + v * (T[2][0] - T[0][0]),
+                             T[0][1] + u * (T[1][1] - T[0][1]) + v * (T[2][1] - T[0][1])}};
+            };
+            Sampling::throw_darts(trials, draw, try_add, grow);
             return true;
           };
           const auto square_covered = [&](const double x0, const double y0, const double size) {

@@ -341,8 +341,10 @@ TEST(Tessellation3D, CellsTileABoxWithABore)
         for (const auto &v : loop)
           m += v / static_cast<double>(loop.size());
         if (std::abs(a[2]) < 1e-12 && std::hypot(m[0] - 0.5, m[1] - 0.45) < r)
-          EXPECT_LT(std::hypot(nuclei[i][0] - 0.5, nuclei[i][1] - 0.45), r * (1 + 1e-12))
-            << "cell " << i << " at " << nuclei[i] << " owns " << a.norm() << " m^2 of the bore";
+          {
+            EXPECT_LT(std::hypot(nuclei[i][0] - 0.5, nuclei[i][1] - 0.45), r * (1 + 1e-12))
+              << "cell " << i << " at " << nuclei[i] << " owns " << a.norm() << " m^2 of the bore";
+          }
       }
   const double A = 0.5 * n * r * r * std::sin(2 * M_PI / n);
   EXPECT_NEAR(total, 2 * (1 - A) + 4 * 0.5 + n * 2 * r * std::sin(M_PI / n) * 0.5, 1e-12);
@@ -441,9 +443,12 @@ TEST(Tessellation3D, CellsTileAnLAndASphere)
   const double inradius = 0.6 * std::cos(h / 0.6); // well below it: edges <= h
   for (unsigned int i = 0; i < t.cells.size(); ++i)
     if (nuclei[i].distance(c) < 1)
-      for (const auto &loop : t.cells[i].boundary)
-        EXPECT_GT(nuclei[i].distance(c), inradius)
-          << "cell " << i << " at " << nuclei[i] << " owns " << area_vector(loop).norm() << " m^2 of the sphere";
+      {
+        for (const auto &loop : t.cells[i].boundary)
+          EXPECT_GT(nuclei[i].distance(c), inradius)
+            << "cell " << i << " at " << nuclei[i] << " owns " << area_vector(loop).norm()
+            << " m^2 of the sphere";
+      }
 }
 
 
