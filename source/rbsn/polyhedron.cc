@@ -959,15 +959,9 @@ namespace hysteron
                 // X n P = X n (the half-spaces of the faces of P that meet X's box B):
                 // within B, P is bounded by those faces alone. Without such a face, X
                 // lies inside P or outside.
-                int dropped = -1;
-                if (side != nullptr)
-                  for (const auto &c : side->changes)
-                    if (c.first == node.primitive)
-                      {
-                        if (c.second < 0)
-                          return;
-                        dropped = c.second;
-                      }
+                const int dropped = Side::change(side, node.primitive);
+                if (dropped == -1)
+                  return;
                 const Primitive          &q = primitive[node.primitive];
                 std::vector<unsigned int> near;
                 near_planes(q, b, near);
@@ -1033,18 +1027,12 @@ namespace hysteron
             case Geometry::Region<3>::Op::push:
               {
                 // X \ P = U_j X n h_1 n ... n h_(j-1) n not h_j over the near faces.
-                int dropped = -1;
-                if (side != nullptr)
-                  for (const auto &c : side->changes)
-                    if (c.first == node.primitive)
-                      {
-                        if (c.second < 0)
-                          {
-                            out.push_back(X);
-                            return;
-                          }
-                        dropped = c.second;
-                      }
+                const int dropped = Side::change(side, node.primitive);
+                if (dropped == -1)
+                  {
+                    out.push_back(X);
+                    return;
+                  }
                 const Primitive          &q = primitive[node.primitive];
                 std::vector<unsigned int> near;
                 near_planes(q, b, near);

@@ -451,6 +451,23 @@ namespace hysteron
         struct Side
         {
           std::vector<std::pair<unsigned int, int>> changes; ///< primitive, dropped plane or -1 (empty)
+
+          /// What the side does to a primitive: drops plane p (p >= 0), empties it
+          /// (-1), or nothing (-2).
+          static int
+          change(const Side *side, const unsigned int primitive)
+          {
+            int result = -2;
+            if (side != nullptr)
+              for (const auto &c : side->changes)
+                if (c.first == primitive)
+                  {
+                    if (c.second < 0)
+                      return -1;
+                    result = c.second;
+                  }
+            return result;
+          }
         };
 
         Side

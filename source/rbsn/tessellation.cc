@@ -3,16 +3,8 @@
 #include <hysteron/base/exceptions.h>
 #include <hysteron/rbsn/tessellation.h>
 
+#include "rbsn/cgal.h"
 #include "rbsn/sampling.h"
-
-// CGAL's headers are not warning-clean under -Wall -Wextra.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <CGAL/Delaunay_triangulation_2.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_vertex_base_with_info_2.h>
-#pragma GCC diagnostic pop
 
 #include <algorithm>
 #include <cmath>

@@ -2,18 +2,8 @@
 #include <hysteron/rbsn/tessellation.h>
 
 #include "rbsn/polyhedron.h"
+#include "rbsn/cgal.h"
 #include "rbsn/sampling.h"
-
-// CGAL's headers are not warning-clean under -Wall -Wextra.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <CGAL/Delaunay_triangulation_2.h>
-#include <CGAL/Delaunay_triangulation_3.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_vertex_base_with_info_2.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
-#pragma GCC diagnostic pop
 
 #include <algorithm>
 #include <array>
