@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The RBSN's parallel VTU: tests/rbsn/rupture_force.prm with VTU output on 2 ranks writes, per
 output time, one piece per rank and a .pvtu record naming both; the pieces hold every cell
-polygon and every facet line exactly once (cells + facets of the network, split by METIS), with
+polygon and every facet line exactly once (cells + facets of the network, split by coordinate bisection), with
 the arrays the record declares, and the fragments and released cells of the last output match
 fracture.csv (the right half released).
 
