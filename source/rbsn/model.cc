@@ -136,7 +136,10 @@ namespace hysteron
                           "cg (the uncoupled and elastic springs: a symmetric tangent) or gmres: "
                           "Krylov iterations with ML algebraic multigrid that knows the rigid-body "
                           "modes of every cell (3 in 2D, 6 in 3D: translations and rotations about "
-                          "the network's centre), to `Linear solver tolerance` of the residual.");
+                          "the network's centre), to `Linear solver tolerance` of the residual. "
+                          "In 3D the direct solver's fill grows fast (about 0.3 MB per cell at "
+                          "14,000 cells): from a few thousand 3D cells cg or gmres is faster "
+                          "and smaller (doc/benchmarks.md).");
         prm.declare_entry("Linear solver tolerance",
                           "1e-10",
                           Patterns::Double(),
