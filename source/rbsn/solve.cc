@@ -87,18 +87,26 @@ namespace hysteron
       // The springs' matrix for the tangent D: B^T D B (the diagonal of D only, for linear
       // springs and laws of independent springs; else the full, not necessarily symmetric
       // D), in dynamics times 1 + alpha. Linear in D.
+      // As B^T (D B): n_s n_e (n_s + n_e) products instead of n_e^2 n_s^2.
+      double     DB[n_dofs][n_e];
       const auto spring_matrix = [&](const Springs<dim> &sp, const SpringMatrix &D, dealii::FullMatrix<double> &M) {
         const bool diagonal = diagonal_law || !sp.hysteretic;
+        for (unsigned int i = 0; i < n_dofs; ++i)
+          for (unsigned int q = 0; q < n_e; ++q)
+            if (diagonal)
+              DB[i][q] = D[i][i] * sp.B[i][q];
+            else
+              {
+                DB[i][q] = 0;
+                for (unsigned int j = 0; j < n_dofs; ++j)
+                  DB[i][q] += D[i][j] * sp.B[j][q];
+              }
         for (unsigned int p = 0; p < n_e; ++p)
           for (unsigned int q = 0; q < n_e; ++q)
             {
               M(p, q) = 0;
               for (unsigned int i = 0; i < n_dofs; ++i)
-                if (diagonal)
-                  M(p, q) += sp.B[i][p] * D[i][i] * sp.B[i][q];
-                else
-                  for (unsigned int j = 0; j < n_dofs; ++j)
-                    M(p, q) += sp.B[i][p] * D[i][j] * sp.B[j][q];
+                M(p, q) += sp.B[i][p] * DB[i][q];
             }
         if (dynamic)
           M *= 1 + alpha;
