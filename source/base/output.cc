@@ -191,11 +191,20 @@ namespace hysteron
         }
       else
         {
-          fd = ::open(filename.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+          // The header goes into "<name>.tmp", which is then renamed: the table
+          // never exists under its name without its header (a run killed before
+          // its first flush leaves a readable table with no rows, not an empty
+          // file), and a table of an earlier run is replaced in one step.
+          const std::string temporary = filename + ".tmp";
+          fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
           if (fd < 0)
-            throw RuntimeError("cannot open '" + filename + "' for writing: " +
+            throw RuntimeError("cannot open '" + temporary + "' for writing: " +
                                std::strerror(errno));
           buffer = header_line(columns);
+          flush();
+          if (::rename(temporary.c_str(), filename.c_str()) != 0)
+            throw RuntimeError("cannot rename '" + temporary + "' to '" + filename +
+                               "': " + std::strerror(errno));
         }
       record.add_file(filename);
       record.register_table(this);
