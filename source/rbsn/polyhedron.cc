@@ -123,14 +123,13 @@ namespace hysteron
 
 
       Cut
-      Clipper::clip(const ConvexPolyhedron &in, const Plane &plane, const int tag, ConvexPolyhedron &out)
+      Clipper::classify(const std::vector<Point> &vertices, const Plane &plane)
       {
-        const unsigned int nv = in.vertices.size();
-        value.resize(nv);
+        value.resize(vertices.size());
         double lo = std::numeric_limits<double>::max(), hi = -lo;
-        for (unsigned int v = 0; v < nv; ++v)
+        for (unsigned int v = 0; v < vertices.size(); ++v)
           {
-            value[v] = plane(in.vertices[v]);
+            value[v] = plane(vertices[v]);
             lo       = std::min(lo, value[v]);
             hi       = std::max(hi, value[v]);
           }
@@ -138,6 +137,17 @@ namespace hysteron
           return Cut::inside;
         if (lo >= -tolerance)
           return Cut::outside;
+        return Cut::cut;
+      }
+
+
+
+      Cut
+      Clipper::clip(const ConvexPolyhedron &in, const Plane &plane, const int tag, ConvexPolyhedron &out)
+      {
+        const unsigned int nv = in.vertices.size();
+        if (const Cut c = classify(in.vertices, plane); c != Cut::cut)
+          return c;
 
         // The vertices kept (in the half-space or on the plane), then one new vertex on
         // every edge from strictly inside to strictly outside, shared by its two faces.
@@ -303,18 +313,8 @@ namespace hysteron
       Clipper::clip(const ConvexPolygon &in, const Plane &plane, const int, ConvexPolygon &out)
       {
         const unsigned int n = in.vertices.size();
-        value.resize(n);
-        double lo = std::numeric_limits<double>::max(), hi = -lo;
-        for (unsigned int v = 0; v < n; ++v)
-          {
-            value[v] = plane(in.vertices[v]);
-            lo       = std::min(lo, value[v]);
-            hi       = std::max(hi, value[v]);
-          }
-        if (hi <= tolerance)
-          return Cut::inside;
-        if (lo >= -tolerance)
-          return Cut::outside;
+        if (const Cut c = classify(in.vertices, plane); c != Cut::cut)
+          return c;
         // Sutherland-Hodgman for one plane; the new point computed from the inside end.
         out.vertices.clear();
         out.normal = in.normal;

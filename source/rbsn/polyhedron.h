@@ -248,6 +248,11 @@ namespace hysteron
         double tolerance;
 
       private:
+        /// value = the plane's signed distance at each vertex; inside or outside when no
+        /// vertex lies beyond the tolerance on the other side, cut otherwise.
+        Cut
+        classify(const std::vector<Point> &vertices, const Plane &plane);
+
         std::vector<double>                                   value;
         std::vector<int>                                      index;
         std::vector<std::pair<std::pair<unsigned int, unsigned int>, unsigned int>> cuts;
