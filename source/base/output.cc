@@ -177,35 +177,27 @@ namespace hysteron
       , n_columns_(columns.size())
       , last_flush(wall_seconds())
     {
-      auto              &record = RunRecord::get();
-      const std::int64_t keep   = record.resume_size(record.relative(filename));
-      if (keep >= 0)
+      auto        &record  = RunRecord::get();
+      std::int64_t keep    = record.resume_size(record.relative(filename));
+      const bool   resumed = keep >= 0;
+      if (!resumed)
         {
-          // Resume: the rows up to the checkpoint stay, the rest is cut off.
-          fd = ::open(filename.c_str(), O_WRONLY | O_CLOEXEC);
-          if (fd < 0 || ::ftruncate(fd, keep) != 0 || ::lseek(fd, keep, SEEK_SET) != keep)
-            throw RuntimeError("cannot resume the table '" + filename +
-                               "' (it should have at least " + std::to_string(keep) +
-                               " bytes from the checkpoint): " + std::strerror(errno));
-          written = keep;
+          // A new table: its header is written atomically (temporary file, then rename), so
+          // the table never exists under its name without it (a run killed before its first
+          // flush leaves a table with no rows, not an empty file).
+          const std::string header = header_line(columns);
+          write_file(filename, header);
+          keep = header.size();
         }
-      else
-        {
-          // The header goes into "<name>.tmp", which is then renamed: the table
-          // never exists under its name without its header (a run killed before
-          // its first flush leaves a readable table with no rows, not an empty
-          // file), and a table of an earlier run is replaced in one step.
-          const std::string temporary = filename + ".tmp";
-          fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-          if (fd < 0)
-            throw RuntimeError("cannot open '" + temporary + "' for writing: " +
-                               std::strerror(errno));
-          buffer = header_line(columns);
-          flush();
-          if (::rename(temporary.c_str(), filename.c_str()) != 0)
-            throw RuntimeError("cannot rename '" + temporary + "' to '" + filename +
-                               "': " + std::strerror(errno));
-        }
+      // The rows follow the first keep bytes: the header, or on resume the rows up to the
+      // checkpoint (the rest is cut off).
+      fd = ::open(filename.c_str(), O_WRONLY | O_CLOEXEC);
+      if (fd < 0 || ::ftruncate(fd, keep) != 0 || ::lseek(fd, keep, SEEK_SET) != keep)
+        throw RuntimeError(resumed ? "cannot resume the table '" + filename +
+                                       "' (it should have at least " + std::to_string(keep) +
+                                       " bytes from the checkpoint): " + std::strerror(errno) :
+                                     "cannot write '" + filename + "': " + std::strerror(errno));
+      written = keep;
       record.add_file(filename);
       record.register_table(this);
     }
