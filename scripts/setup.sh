@@ -15,6 +15,7 @@ packages=(
   python3-matplotlib  # figures in doc/
   gnuplot-nox
   libcgal-dev         # Voronoi cells (RBSN)
+  zlib1g-dev          # CRC-32 of checkpoint files and inputs
   libsuitesparse-dev  # UMFPACK, called directly for the RBSN's kept symbolic analysis
   libopenblas0-serial # an optimised BLAS/LAPACK behind libblas.so.3 (the sparse direct
                       # solvers' dense kernels; Debian's default is the reference BLAS)

@@ -190,8 +190,16 @@ namespace hysteron
           keep = header.size();
         }
       // The rows follow the first keep bytes: the header, or on resume the rows up to the
-      // checkpoint (the rest is cut off).
+      // checkpoint (the rest is cut off). A shorter file is refused: ftruncate would pad
+      // it with NUL bytes (the resume checks the tables' rows before it gets here).
       fd = ::open(filename.c_str(), O_WRONLY | O_CLOEXEC);
+      struct stat status;
+      if (fd >= 0 && resumed && (::fstat(fd, &status) != 0 || status.st_size < keep))
+        {
+          ::close(fd);
+          throw RuntimeError("cannot resume the table '" + filename + "': it has fewer than the " +
+                             std::to_string(keep) + " bytes it had at the checkpoint");
+        }
       if (fd < 0 || ::ftruncate(fd, keep) != 0 || ::lseek(fd, keep, SEEK_SET) != keep)
         throw RuntimeError(resumed ? "cannot resume the table '" + filename +
                                        "' (it should have at least " + std::to_string(keep) +
@@ -250,6 +258,14 @@ namespace hysteron
         }
       written += buffer.size();
       buffer.clear();
+    }
+
+    void
+    TimeTable::sync()
+    {
+      flush();
+      if (::fsync(fd) != 0)
+        throw RuntimeError("cannot write '" + name + "' to disk: " + std::strerror(errno));
     }
 
     FieldWriter::FieldWriter(const std::string &directory,

@@ -100,6 +100,13 @@ namespace hysteron
         table->flush();
     }
 
+    void
+    RunRecord::sync_tables()
+    {
+      for (auto *table : tables)
+        table->sync();
+    }
+
     std::map<std::string, std::uint64_t>
     RunRecord::table_sizes() const
     {

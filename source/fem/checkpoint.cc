@@ -37,7 +37,7 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::save(CheckpointWriter &out) const
+    Solver<dim>::save(CheckpointWriter &, CheckpointWriter &out, const CheckpointDirectory &) const
     {
       out.section("fem vectors");
       out.put<std::uint64_t>(dof_handler.n_dofs());
@@ -71,15 +71,20 @@ namespace hysteron
       out.put(n_linear);
       out.put(increments.state());
       out.put(step_checked);
-      tables.save(out);
+      const_cast<PointData::Tables<dim> &>(tables).serialize(out);
     }
 
 
 
     template <int dim>
     void
-    Solver<dim>::load(CheckpointReader &in)
+    Solver<dim>::load(CheckpointReader &, std::vector<CheckpointReader> &parts, const CheckpointDirectory &directory)
     {
+      if (!directory.same_ranks())
+        throw InputError("--resume",
+                         "the fem method resumes on as many MPI ranks as wrote the checkpoint (" +
+                           std::to_string(directory.saved_ranks) + ")");
+      CheckpointReader &in = parts[0];
       in.section("fem vectors");
       if (in.get<std::uint64_t>() != dof_handler.n_dofs())
         in.refuse("the mesh has another number of DoFs than the checkpoint's");
@@ -120,12 +125,12 @@ namespace hysteron
       in.get(n_linear);
       increments.restore(in.get<std::array<double, 4>>());
       in.get(step_checked);
-      tables.load(in);
+      tables.serialize(in);
     }
 
-    template void Solver<2>::save(CheckpointWriter &) const;
-    template void Solver<3>::save(CheckpointWriter &) const;
-    template void Solver<2>::load(CheckpointReader &);
-    template void Solver<3>::load(CheckpointReader &);
+    template void Solver<2>::save(CheckpointWriter &, CheckpointWriter &, const CheckpointDirectory &) const;
+    template void Solver<3>::save(CheckpointWriter &, CheckpointWriter &, const CheckpointDirectory &) const;
+    template void Solver<2>::load(CheckpointReader &, std::vector<CheckpointReader> &, const CheckpointDirectory &);
+    template void Solver<3>::load(CheckpointReader &, std::vector<CheckpointReader> &, const CheckpointDirectory &);
   } // namespace FEM
 } // namespace hysteron

@@ -836,6 +836,8 @@ namespace hysteron
     fill(const Region<dim>                                                    &region,
          const FillLattice<dim>                                               &lattice,
          const unsigned int                                                    k,
+         const std::array<unsigned int, dim>                                  &range_first,
+         const std::array<unsigned int, dim>                                  &range_last,
          const std::function<bool(const std::array<unsigned int, dim> &cell)> &keep_cell)
     {
       AssertThrow(lattice.h > 0 && std::isfinite(lattice.h),
@@ -859,8 +861,9 @@ namespace hysteron
           const double n  = lattice.n_cells[d];
           const double lo = (corners.first[d] - margin - lattice.origin[d]) / h - 1;
           const double hi = (corners.second[d] + margin - lattice.origin[d]) / h;
-          const double f  = std::max(0.0, std::ceil(std::min(lo, n)));
-          const double l  = std::min(n - 1, std::floor(std::max(hi, -1.0)));
+          const double f  = std::max<double>(range_first[d], std::ceil(std::min(lo, n)));
+          const double l  = std::min<double>(std::min<double>(n - 1, range_last[d]),
+                                             std::floor(std::max(hi, -1.0)));
           if (l < f)
             return points;
           first[d] = static_cast<unsigned int>(f);
@@ -910,7 +913,10 @@ namespace hysteron
     std::vector<dealii::Point<dim>>
     fill(const Region<dim> &region, const FillLattice<dim> &lattice, const unsigned int k)
     {
-      return fill<dim>(region, lattice, k, {});
+      std::array<unsigned int, dim> first{}, last;
+      for (unsigned int d = 0; d < dim; ++d)
+        last[d] = lattice.n_cells[d] > 0 ? lattice.n_cells[d] - 1 : 0;
+      return fill<dim>(region, lattice, k, first, last);
     }
 
 
@@ -925,14 +931,18 @@ namespace hysteron
     fill(const Region<3> &, const FillLattice<3> &, unsigned int);
     template std::vector<dealii::Point<2>>
     fill<2>(const Region<2> &,
-         const FillLattice<2> &,
-         unsigned int,
-         const std::function<bool(const std::array<unsigned int, 2> &)> &);
+              const FillLattice<2> &,
+              unsigned int,
+              const std::array<unsigned int, 2> &,
+              const std::array<unsigned int, 2> &,
+              const std::function<bool(const std::array<unsigned int, 2> &)> &);
     template std::vector<dealii::Point<3>>
     fill<3>(const Region<3> &,
-         const FillLattice<3> &,
-         unsigned int,
-         const std::function<bool(const std::array<unsigned int, 3> &)> &);
+              const FillLattice<3> &,
+              unsigned int,
+              const std::array<unsigned int, 3> &,
+              const std::array<unsigned int, 3> &,
+              const std::function<bool(const std::array<unsigned int, 3> &)> &);
     template double
     fill_particle_volume(const FillLattice<2> &, unsigned int);
     template double

@@ -1,5 +1,4 @@
-#include <deal.II/dofs/dof_tools.h>
-#include <deal.II/fe/fe_q.h>
+#include <deal.II/base/index_set.h>
 #include <deal.II/grid/grid_generator.h>
 
 #include <hysteron/base/exceptions.h>
@@ -7,12 +6,60 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstring>
 #include <cmath>
+#include <limits>
+#include <map>
 
 namespace hysteron
 {
   namespace MPM
   {
+    namespace
+    {
+      /**
+       * The coarse mesh of the blocks: r_d trees per direction, each refined L
+       * times, with r_d 2^L >= n_d. The trees are replicated on every rank, the
+       * refined blocks distributed, and the padding (r_d 2^L - n_d blocks) holds
+       * no lattice cell and weighs nothing. The choice of L minimises
+       * (trees) + (all blocks) / 64, i.e. a tree is counted as costly as 64 blocks
+       * (it is kept on every rank); it depends on the lattice only, so that a
+       * checkpoint's triangulation can be loaded on any number of ranks.
+       */
+      template <int dim>
+      std::pair<std::array<unsigned int, dim>, unsigned int>
+      coarse_mesh_of_blocks(const std::array<unsigned int, dim> &n)
+      {
+        std::array<unsigned int, dim> best_r{};
+        unsigned int                  best_level = 0;
+        double                        best_cost  = std::numeric_limits<double>::max();
+        for (unsigned int level = 0; level < 20; ++level)
+          {
+            const unsigned int            side = 1u << level;
+            std::array<unsigned int, dim> r;
+            double                        trees = 1, blocks = 1;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                r[d] = (n[d] + side - 1) / side;
+                trees *= r[d];
+                blocks *= double(r[d]) * side;
+              }
+            const double cost = trees + blocks / 64;
+            if (cost < best_cost)
+              {
+                best_cost  = cost;
+                best_r     = r;
+                best_level = level;
+              }
+            if (*std::max_element(r.begin(), r.end()) == 1)
+              break;
+          }
+        return {best_r, best_level};
+      }
+    } // namespace
+
+
+
     template <int dim>
     BackgroundGrid<dim>::BackgroundGrid(MPI_Comm comm)
       : comm(comm)
@@ -24,72 +71,301 @@ namespace hysteron
 
     template <int dim>
     void
-    BackgroundGrid<dim>::initialize(const dealii::Point<dim>            &lower,
-                                    const double                          h,
-                                    const std::array<unsigned int, dim> &n_cells,
-                                    const unsigned int                    n_components,
-                                    const std::vector<unsigned int>      &work_per_cell)
+    BackgroundGrid<dim>::make_coarse_mesh(const dealii::Point<dim>            &lower,
+                                          const double                          h,
+                                          const std::array<unsigned int, dim> &n_cells,
+                                          const unsigned int                    support_margin)
     {
       using namespace dealii;
       grid_lattice.origin  = lower;
       grid_lattice.h       = uniform_h<dim>(h);
       grid_lattice.n_cells = n_cells;
       initial_lattice      = grid_lattice;
-      n_comp               = n_components;
+      margin               = support_margin;
 
-      std::vector<unsigned int> repetitions(n_cells.begin(), n_cells.end());
-      Point<dim>                upper = lower;
-      unsigned int              n_lattice_cells = 1;
       for (unsigned int d = 0; d < dim; ++d)
-        {
-          upper[d] += n_cells[d] * h;
-          n_lattice_cells *= n_cells[d];
-        }
+        n_blocks[d] = (n_cells[d] + block_size() - 1) / block_size();
+      const auto [trees, level] = coarse_mesh_of_blocks<dim>(n_blocks);
+      coarse_level              = level;
+      std::vector<unsigned int> repetitions(trees.begin(), trees.end());
+      Point<dim>                upper = lower;
+      for (unsigned int d = 0; d < dim; ++d)
+        upper[d] += double(trees[d]) * (1u << level) * block_size() * h;
+      tria.clear();
       GridGenerator::subdivided_hyper_rectangle(tria, repetitions, lower, upper);
-      if (n_ranks > 1 && !work_per_cell.empty())
-        {
-          // p4est adds up these weights along its space-filling curve; a cell
-          // without points still costs a little (its share of the grid).
-          auto connection = tria.signals.weight.connect(
-            [&](const typename Triangulation<dim>::cell_iterator &cell,
-                const typename Triangulation<dim>::CellStatus) -> unsigned int {
-              std::array<unsigned int, dim> c;
-              for (unsigned int d = 0; d < dim; ++d)
-                c[d] = static_cast<unsigned int>(std::floor((cell->center()[d] - lower[d]) / h));
-              return 1000u * work_per_cell[cell_id(c)];
-            });
-          tria.repartition();
-          connection.disconnect();
-        }
+    }
 
-      // Which lattice cell is which triangulation cell, and who owns it.
-      owned_cell.assign(n_lattice_cells, 0);
-      cell_index.assign(n_lattice_cells, -1);
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::create(const dealii::Point<dim>            &lower,
+                                const double                          h,
+                                const std::array<unsigned int, dim> &n_cells,
+                                const unsigned int                    support_margin)
+    {
+      make_coarse_mesh(lower, h, n_cells, support_margin);
+      tria.refine_global(coarse_level);
+      setup_blocks();
+    }
+
+
+
+    template <int dim>
+    std::pair<unsigned int, unsigned int>
+    BackgroundGrid<dim>::attach(const BlockPacker &pack)
+    {
+      using namespace dealii;
+      using cell_iterator = typename Triangulation<dim>::cell_iterator;
+      using CellStatus    = typename Triangulation<dim>::CellStatus;
+      // The partition's weight of each block (4 bytes), then the caller's data.
+      const unsigned int weights = tria.register_data_attach(
+        [this](const cell_iterator &cell, const CellStatus) {
+          const auto    it = block_weight.find(block_of_cell(cell));
+          std::uint32_t w  = it == block_weight.end() ? 0 : it->second;
+          return std::vector<char>(reinterpret_cast<const char *>(&w), reinterpret_cast<const char *>(&w) + 4);
+        },
+        /*returns_variable_size_data=*/false);
+      const unsigned int data = tria.register_data_attach(
+        [this, pack](const cell_iterator &cell, const CellStatus) {
+          const auto b = block_of_cell(cell);
+          return in_lattice(b) && pack ? pack(b) : std::vector<char>();
+        },
+        /*returns_variable_size_data=*/true);
+      return {weights, data};
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::receive(const std::pair<unsigned int, unsigned int> &handles, const BlockUnpacker &unpack)
+    {
+      using namespace dealii;
+      using cell_iterator = typename Triangulation<dim>::cell_iterator;
+      using CellStatus    = typename Triangulation<dim>::CellStatus;
+      using Range         = boost::iterator_range<std::vector<char>::const_iterator>;
+      block_weight.clear();
+      tria.notify_ready_to_unpack(handles.first, [this](const cell_iterator &cell, const CellStatus, const Range &data) {
+        std::uint32_t w = 0;
+        if (data.size() == 4)
+          std::memcpy(&w, &*data.begin(), 4);
+        const auto b = block_of_cell(cell);
+        if (in_lattice(b))
+          block_weight[b] = w;
+      });
+      tria.notify_ready_to_unpack(handles.second, [&](const cell_iterator &cell, const CellStatus, const Range &data) {
+        const auto b = block_of_cell(cell);
+        if (in_lattice(b) && unpack)
+          unpack(b, data);
+      });
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::save(const std::string &file, const BlockPacker &pack)
+    {
+      attach(pack);
+      tria.save(file);
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::load(const dealii::Point<dim>            &lower,
+                              const double                          h,
+                              const std::array<unsigned int, dim> &n_cells,
+                              const unsigned int                    support_margin,
+                              const std::string                    &file,
+                              const bool                            same_ranks,
+                              const BlockUnpacker                  &unpack)
+    {
+      make_coarse_mesh(lower, h, n_cells, support_margin);
+      tria.load(file);
+      // p4est loads its cells in equal numbers: on as many ranks as the checkpoint's,
+      // the saved weights give back the saved partition (p4est's partition is a function
+      // of the weights along its curve).
+      std::map<std::array<unsigned int, dim>, std::vector<char>> data;
+      const auto keep = [&](const std::array<unsigned int, dim>                              &block,
+                            const boost::iterator_range<std::vector<char>::const_iterator> &bytes) {
+        data[block].assign(bytes.begin(), bytes.end());
+      };
+      receive(attach({}), keep);
+      bool weighted = false;
+      for (const auto &w : block_weight)
+        weighted = weighted || w.second > 0;
+      weighted = dealii::Utilities::MPI::logical_or(weighted, comm);
+      if (same_ranks && weighted && n_ranks > 1)
+        {
+          const auto saved = block_weight;
+          std::map<std::array<unsigned int, dim>, std::vector<char>> moving;
+          moving.swap(data);
+          repartition(
+            [&](const std::array<unsigned int, dim> &b) {
+              const auto it = saved.find(b);
+              return it == saved.end() ? 0u : it->second;
+            },
+            [&](const std::array<unsigned int, dim> &b) {
+              const auto it = moving.find(b);
+              return it == moving.end() ? std::vector<char>() : it->second;
+            },
+            keep);
+        }
+      else
+        setup_blocks();
+      for (const auto &[block, bytes] : data)
+        unpack(block, boost::make_iterator_range(bytes.cbegin(), bytes.cend()));
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::repartition(
+      const std::function<unsigned int(const std::array<unsigned int, dim> &)> &weight,
+      const BlockPacker                                                        &pack,
+      const BlockUnpacker                                                      &unpack)
+    {
+      using namespace dealii;
+      if (n_ranks == 1)
+        return;
+      // p4est adds up these weights along its space-filling curve; each block's weight and
+      // data (if any) move with it, so that a checkpoint can restore this partition.
+      block_weight.clear();
+      for (const auto &cell : tria.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            const auto b = block_of_cell(cell);
+            if (in_lattice(b))
+              block_weight[b] = weight(b);
+          }
+      auto connection = tria.signals.weight.connect(
+        [&](const typename Triangulation<dim>::cell_iterator &cell,
+            const typename Triangulation<dim>::CellStatus) -> unsigned int {
+          const auto it = block_weight.find(block_of_cell(cell));
+          return it == block_weight.end() ? 0u : it->second;
+        });
+      const auto handles = attach(pack);
+      tria.repartition();
+      connection.disconnect();
+      receive(handles, unpack);
+      setup_blocks();
+    }
+
+
+
+    template <int dim>
+    std::array<unsigned int, dim>
+    BackgroundGrid<dim>::block_of_cell(const typename dealii::Triangulation<dim>::cell_iterator &cell) const
+    {
+      std::array<unsigned int, dim> b;
+      const double                  side   = block_size() * initial_lattice.h[0];
+      const dealii::Point<dim>      centre = cell->center();
+      for (unsigned int d = 0; d < dim; ++d)
+        b[d] = static_cast<unsigned int>(std::floor((centre[d] - initial_lattice.origin[d]) / side));
+      return b;
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::setup_blocks()
+    {
+      using namespace dealii;
+      // The box of the owned and ghost blocks that hold lattice cells.
       std::array<int, dim> low, high;
       low.fill(INT_MAX);
       high.fill(INT_MIN);
+      std::vector<std::pair<CellId, std::array<unsigned int, dim>>> owned;
       for (const auto &cell : tria.active_cell_iterators())
         if (!cell->is_artificial())
           {
-            std::array<unsigned int, dim> c;
-            const Point<dim>              center = cell->center();
+            const auto b = block_of_cell(cell);
+            if (!in_lattice(b))
+              continue;
             for (unsigned int d = 0; d < dim; ++d)
               {
-                c[d] = static_cast<unsigned int>(std::floor((center[d] - lower[d]) / h));
-                low[d]  = std::min<int>(low[d], c[d]);
-                high[d] = std::max<int>(high[d], c[d] + 1);
+                low[d]  = std::min<int>(low[d], b[d]);
+                high[d] = std::max<int>(high[d], b[d] + 1);
               }
-            const unsigned int id = cell_id(c);
-            cell_index[id]        = cell->index();
-            owned_cell[id]        = cell->is_locally_owned() ? 1 : 0;
+            if (cell->is_locally_owned())
+              owned.emplace_back(cell->id(), b);
           }
-
-      // The dense box of the locally relevant nodes (a rank without cells gets an empty box).
-      n_box_nodes = 1;
+      std::size_t n = 1;
       for (unsigned int d = 0; d < dim; ++d)
         {
           if (high[d] < low[d])
             low[d] = high[d] = 0;
+          block_box_low[d]  = low[d];
+          block_box_size[d] = high[d] - low[d];
+          n *= block_box_size[d];
+        }
+      block_state.assign(n, no_block);
+      block_owner.assign(n, 0);
+      block_cell.assign(n, {-1, -1});
+      for (const auto &cell : tria.active_cell_iterators())
+        if (!cell->is_artificial())
+          {
+            const auto b = block_of_cell(cell);
+            if (!in_lattice(b))
+              continue;
+            const int k    = local_block(b);
+            block_state[k] = cell->is_locally_owned() ? owned_block : ghost_block;
+            block_owner[k] = cell->subdomain_id();
+            block_cell[k]  = {cell->level(), cell->index()};
+          }
+      // The owned blocks along the curve: CellIds compare as p4est orders its cells.
+      std::sort(owned.begin(), owned.end(), [](const auto &a, const auto &b) { return a.first < b.first; });
+      owned_block_list.clear();
+      for (const auto &o : owned)
+        owned_block_list.push_back(o.second);
+
+      // The lattice cells of the owned blocks lie in this range.
+      auto &[first, last] = owned_range;
+      first.fill(UINT_MAX);
+      last.fill(0);
+      for (const auto &b : owned_block_list)
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            first[d] = std::min(first[d], b[d] * block_size());
+            last[d]  = std::max(last[d], std::min((b[d] + 1) * block_size(), grid_lattice.n_cells[d]) - 1);
+          }
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::setup_nodes(const unsigned int n_components)
+    {
+      n_comp = n_components;
+      // The box of the nodes the owned blocks' points reach: a block's cells' nodes and
+      // `margin` layers around them, within the lattice.
+      std::array<int, dim> low, high;
+      low.fill(INT_MAX);
+      high.fill(INT_MIN);
+      const auto node_range = [&](const std::array<unsigned int, dim> &b, const unsigned int d) {
+        const int n  = grid_lattice.n_cells[d];
+        const int lo = std::max<int>(0, int(b[d] * block_size()) - int(margin));
+        const int hi = std::min<int>(n, std::min<int>(n, (b[d] + 1) * block_size()) + int(margin));
+        return std::make_pair(lo, hi);
+      };
+      for (const auto &b : owned_block_list)
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const auto [lo, hi] = node_range(b, d);
+            low[d]              = std::min(low[d], lo);
+            high[d]             = std::max(high[d], hi);
+          }
+      n_box_nodes = 1;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          if (high[d] < low[d])
+            low[d] = high[d] = 0; // a rank without blocks: one node, never reached
           box_low[d]    = low[d];
           box_size[d]   = high[d] - low[d] + 1;
           box_stride[d] = n_box_nodes;
@@ -97,66 +373,162 @@ namespace hysteron
         }
       relevant_node.assign(n_box_nodes, 0);
       owned_node.assign(n_box_nodes, 0);
-
-      main.n_comp = n_comp;
-      connect(main, true);
+      for (const auto &b : owned_block_list)
+        {
+          std::array<std::pair<int, int>, dim> range;
+          for (unsigned int d = 0; d < dim; ++d)
+            range[d] = node_range(b, d);
+          std::array<int, dim> i;
+          for (unsigned int d = 0; d < dim; ++d)
+            i[d] = range[d].first;
+          while (true)
+            {
+              const unsigned int n = local_node(i);
+              relevant_node[n]     = 1;
+              // The owner of a node: the block of the cell above it (the last block at
+              // the upper faces).
+              bool mine = true;
+              for (unsigned int d = 0; d < dim; ++d)
+                mine = mine && std::min<unsigned int>(i[d] / block_size(), n_blocks[d] - 1) == b[d];
+              if (mine)
+                owned_node[n] = 1;
+              unsigned int d = 0;
+              for (; d < dim; ++d)
+                if (++i[d] <= range[d].second)
+                  break;
+                else
+                  i[d] = range[d].first;
+              if (d == dim)
+                break;
+            }
+        }
       nodes.assign(std::size_t(n_box_nodes) * n_comp, 0.0);
+      if (n_ranks > 1)
+        {
+          number_nodes();
+          main.n_comp = n_comp;
+          connect(main);
+        }
     }
 
 
 
     template <int dim>
     void
-    BackgroundGrid<dim>::connect(Field &field, const bool set_node_flags)
+    BackgroundGrid<dim>::number_nodes()
     {
       using namespace dealii;
-      field.fe = std::make_unique<FESystem<dim>>(FE_Q<dim>(1), field.n_comp);
-      field.dof_handler.reinit(tria);
-      field.dof_handler.distribute_dofs(*field.fe);
+      // The owned nodes rank by rank, in box order on each.
+      owned_numbers.clear();
+      ghost_numbers.clear();
+      for (unsigned int n = 0; n < n_box_nodes; ++n)
+        if (owned_node[n])
+          owned_numbers.emplace_back(n, owned_numbers.size());
+      const std::uint64_t n_owned = owned_numbers.size();
+      std::uint64_t       first   = 0;
+      const int ierr = MPI_Exscan(&n_owned, &first, 1, MPI_UINT64_T, MPI_SUM, comm);
+      AssertThrowMPI(ierr);
+      if (Utilities::MPI::this_mpi_process(comm) == 0)
+        first = 0;
+      n_global_nodes     = Utilities::MPI::sum(n_owned, comm);
+      first_owned_number = static_cast<unsigned int>(first);
+      for (auto &o : owned_numbers)
+        o.second += first_owned_number;
 
-      IndexSet relevant;
-      DoFTools::extract_locally_relevant_dofs(field.dof_handler, relevant);
-      const IndexSet &owned = field.dof_handler.locally_owned_dofs();
-      field.buffer.reinit(owned, relevant, comm);
-      const auto &partitioner = *field.buffer.get_partitioner();
-
-      std::vector<int>           box_of_local(owned.n_elements() + partitioner.n_ghost_indices(), -1);
-      std::vector<unsigned char> seen(n_box_nodes, 0);
-      field.ghost_nodes.clear();
-      field.import_nodes.clear();
-      // The triangulation keeps the geometry of the set-up.
-      const Point<dim> &lower = initial_lattice.origin;
-      const double      h     = initial_lattice.h[0];
-      for (const auto &cell : field.dof_handler.active_cell_iterators())
-        if (!cell->is_artificial())
-          for (const unsigned int v : cell->vertex_indices())
+      // The ghosts' numbers, asked from their owners (the owners of neighbouring blocks).
+      const auto lattice_node = [&](const std::array<int, dim> &i) {
+        std::array<unsigned int, dim> u;
+        for (unsigned int d = 0; d < dim; ++d)
+          u[d] = i[d];
+        return grid_lattice.node_number(u);
+      };
+      std::map<unsigned int, std::vector<unsigned int>> asked;
+      std::vector<unsigned int>                         ghost_box_nodes;
+      for (unsigned int n = 0; n < n_box_nodes; ++n)
+        if (relevant_node[n] && !owned_node[n])
+          {
+            const auto                    i = lattice_index(n);
+            std::array<unsigned int, dim> b;
+            for (unsigned int d = 0; d < dim; ++d)
+              b[d] = std::min<unsigned int>(i[d] / block_size(), n_blocks[d] - 1);
+            const int k = local_block(b);
+            AssertThrow(k >= 0 && block_state[k] == ghost_block,
+                        ExcMessage("mpm grid: a reached node's block is not a ghost block"));
+            asked[block_owner[k]].push_back(lattice_node(i));
+            ghost_box_nodes.push_back(n);
+          }
+      std::vector<unsigned int> owned_number_of_box(0);
+      const auto                answers = Utilities::MPI::some_to_some(comm, asked);
+      std::map<unsigned int, std::vector<unsigned int>> replies;
+      for (const auto &[rank, list] : answers)
+        {
+          auto &reply = replies[rank];
+          for (const unsigned int node : list)
             {
+              const auto           u = grid_lattice.node_index(node);
               std::array<int, dim> i;
               for (unsigned int d = 0; d < dim; ++d)
-                i[d] = static_cast<int>(std::lround((cell->vertex(v)[d] - lower[d]) / h));
-              const unsigned int n = local_node(i);
-              if (seen[n])
-                continue;
-              seen[n]                         = 1;
-              const types::global_dof_index g = cell->vertex_dof_index(v, 0);
-              for (unsigned int c = 1; c < field.n_comp; ++c)
-                Assert(cell->vertex_dof_index(v, c) == g + c, ExcInternalError());
-              const bool is_owned = owned.is_element(g);
-              if (set_node_flags)
-                {
-                  relevant_node[n] = 1;
-                  owned_node[n]    = is_owned ? 1 : 0;
-                }
-              const unsigned int l = partitioner.global_to_local(g);
-              box_of_local[l]      = n;
-              if (!is_owned)
-                field.ghost_nodes.emplace_back(n, l);
+                i[d] = u[d];
+              const unsigned int n  = local_node(i);
+              const auto         it = std::lower_bound(owned_numbers.begin(),
+                                               owned_numbers.end(),
+                                               std::make_pair(n, 0u));
+              AssertThrow(it != owned_numbers.end() && it->first == n,
+                          ExcMessage("mpm grid: a node asked for is not owned here"));
+              reply.push_back(it->second);
             }
-      // Owned nodes that other ranks also touch: their sums arrive through compress().
+        }
+      const auto numbers = Utilities::MPI::some_to_some(comm, replies);
+      // The replies come in the order of the questions, rank by rank.
+      std::map<unsigned int, std::size_t> next;
+      for (const unsigned int n : ghost_box_nodes)
+        {
+          const auto                    i = lattice_index(n);
+          std::array<unsigned int, dim> b;
+          for (unsigned int d = 0; d < dim; ++d)
+            b[d] = std::min<unsigned int>(i[d] / block_size(), n_blocks[d] - 1);
+          const unsigned int rank = block_owner[local_block(b)];
+          ghost_numbers.emplace_back(n, numbers.at(rank)[next[rank]++]);
+        }
+    }
+
+
+
+    template <int dim>
+    void
+    BackgroundGrid<dim>::connect(Field &field) const
+    {
+      using namespace dealii;
+      const std::uint64_t size = n_global_nodes * field.n_comp;
+      AssertThrow(size < std::numeric_limits<types::global_dof_index>::max(),
+                  ExcMessage("mpm grid: " + std::to_string(n_global_nodes) + " nodes x " +
+                             std::to_string(field.n_comp) +
+                             " values exceed the 32-bit index of this deal.II build"));
+      IndexSet owned(size), ghosts(size);
+      owned.add_range(std::uint64_t(first_owned_number) * field.n_comp,
+                      (std::uint64_t(first_owned_number) + owned_numbers.size()) * field.n_comp);
+      std::vector<types::global_dof_index> ghost_indices;
+      ghost_indices.reserve(ghost_numbers.size() * field.n_comp);
+      for (const auto &g : ghost_numbers)
+        for (unsigned int c = 0; c < field.n_comp; ++c)
+          ghost_indices.push_back(std::uint64_t(g.second) * field.n_comp + c);
+      std::sort(ghost_indices.begin(), ghost_indices.end());
+      ghosts.add_indices(ghost_indices.begin(), ghost_indices.end());
+      field.buffer.reinit(owned, ghosts, comm);
+      const auto &partitioner = *field.buffer.get_partitioner();
+
+      field.ghost_nodes.clear();
+      for (const auto &g : ghost_numbers)
+        field.ghost_nodes.emplace_back(g.first,
+                                       partitioner.global_to_local(std::uint64_t(g.second) * field.n_comp));
+      // Owned nodes that other ranks also reach: their sums arrive through compress().
+      field.import_nodes.clear();
       for (const auto &range : partitioner.import_indices())
         for (unsigned int l = range.first; l < range.second; ++l)
-          if (box_of_local[l] >= 0)
-            field.import_nodes.emplace_back(box_of_local[l], l);
+          {
+            const unsigned int k = l / field.n_comp;
+            field.import_nodes.emplace_back(owned_numbers[k].first, k * field.n_comp);
+          }
       std::sort(field.import_nodes.begin(), field.import_nodes.end());
       field.import_nodes.erase(std::unique(field.import_nodes.begin(), field.import_nodes.end()),
                                field.import_nodes.end());
@@ -166,13 +538,13 @@ namespace hysteron
 
     template <int dim>
     void
-    BackgroundGrid<dim>::initialize_layer(const unsigned int n_blocks, const unsigned int block_size)
+    BackgroundGrid<dim>::initialize_layer(const unsigned int n_blocks_per_node, const unsigned int size_of_block)
     {
-      layer_blocks     = n_blocks;
-      layer_block_size = block_size;
-      layer.n_comp     = n_blocks * block_size;
+      layer_blocks     = n_blocks_per_node;
+      layer_block_size = size_of_block;
+      layer.n_comp     = n_blocks_per_node * size_of_block;
       if (n_ranks > 1)
-        connect(layer, false);
+        connect(layer);
       layer_nodes.assign(std::size_t(n_box_nodes) * layer.n_comp, 0.0);
     }
 
@@ -180,10 +552,13 @@ namespace hysteron
 
     template <int dim>
     typename dealii::Triangulation<dim>::active_cell_iterator
-    BackgroundGrid<dim>::cell_iterator(const unsigned int id) const
+    BackgroundGrid<dim>::cell_iterator(const std::array<unsigned int, dim> &c) const
     {
-      Assert(cell_index[id] >= 0, dealii::ExcInternalError());
-      return typename dealii::Triangulation<dim>::active_cell_iterator(&tria, 0, cell_index[id]);
+      const int k = local_block(block_of(c));
+      Assert(k >= 0 && block_cell[k].first >= 0, dealii::ExcInternalError());
+      return typename dealii::Triangulation<dim>::active_cell_iterator(&tria,
+                                                                       block_cell[k].first,
+                                                                       block_cell[k].second);
     }
 
 
@@ -222,8 +597,8 @@ namespace hysteron
                                     std::vector<double> &values,
                                     const unsigned int   first,
                                     const unsigned int   n,
-                                    const unsigned int   n_blocks,
-                                    const unsigned int   block_size)
+                                    const unsigned int   n_blocks_per_node,
+                                    const unsigned int   size_of_block)
     {
       // Ghost entries carry this rank's contributions (only the exchanged
       // components are non-zero), owned shared entries this rank's own part;
@@ -233,8 +608,8 @@ namespace hysteron
       const unsigned int stride = field.n_comp;
       const auto         copy   = [&](const auto &list, const bool to_buffer) {
         for (const auto &[box, l] : list)
-          for (unsigned int b = 0; b < n_blocks; ++b)
-            for (unsigned int c = first + b * block_size; c < first + b * block_size + n; ++c)
+          for (unsigned int b = 0; b < n_blocks_per_node; ++b)
+            for (unsigned int c = first + b * size_of_block; c < first + b * size_of_block + n; ++c)
               if (to_buffer)
                 field.buffer.local_element(l + c) = values[std::size_t(box) * stride + c];
               else
@@ -292,6 +667,25 @@ namespace hysteron
           for (unsigned int b = 0; b < layer_blocks; ++b)
             for (unsigned int c = first + b * layer_block_size; c < first + b * layer_block_size + n; ++c)
               layer_nodes[std::size_t(entry.first) * layer.n_comp + c] = 0.0;
+    }
+
+
+
+    template <int dim>
+    std::size_t
+    BackgroundGrid<dim>::memory_consumption() const
+    {
+      std::size_t bytes = (nodes.capacity() + layer_nodes.capacity()) * sizeof(double) +
+                          relevant_node.capacity() + owned_node.capacity() + block_state.capacity() +
+                          block_owner.capacity() * sizeof(unsigned int) +
+                          block_cell.capacity() * sizeof(std::pair<int, int>) +
+                          (owned_numbers.capacity() + ghost_numbers.capacity()) *
+                            sizeof(std::pair<unsigned int, unsigned int>);
+      for (const Field *f : {&main, &layer})
+        bytes += f->buffer.memory_consumption() +
+                 (f->ghost_nodes.capacity() + f->import_nodes.capacity()) *
+                   sizeof(std::pair<unsigned int, unsigned int>);
+      return bytes;
     }
 
 

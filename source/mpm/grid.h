@@ -1,16 +1,19 @@
 #ifndef hysteron_source_mpm_grid_h
 #define hysteron_source_mpm_grid_h
 
-#include <deal.II/base/index_set.h>
 #include <deal.II/base/mpi.h>
+#include <deal.II/base/partitioner.h>
 #include <deal.II/distributed/tria.h>
-#include <deal.II/dofs/dof_handler.h>
-#include <deal.II/fe/fe_system.h>
 #include <deal.II/lac/la_parallel_vector.h>
+
+#include <boost/range/iterator_range.hpp>
 
 #include "mpm/basis.h"
 
 #include <array>
+#include <cstdint>
+#include <functional>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -19,19 +22,32 @@ namespace hysteron
   namespace MPM
   {
     /**
-     * The background grid of the MPM: a Cartesian box of cubic cells on a
-     * parallel::distributed::Triangulation (one coarse cell per grid cell, so
-     * that p4est partitions the cells) with a DoFHandler whose vertex DoFs are
-     * the grid nodes (an FESystem of n_components FE_Q(1), one per nodal
-     * quantity).
+     * The background grid of the MPM: a Cartesian lattice of n_cells cells of
+     * size h, and a parallel::distributed::Triangulation whose cells are
+     * *blocks* of block_size()^dim lattice cells, so that p4est partitions the
+     * blocks between the ranks (weighted by the work in them) and the
+     * ParticleHandler keeps each material point in its block.
      *
-     * The kernels do not go through the DoFHandler. Each rank keeps the nodal
-     * data of the lattice box that covers its locally relevant nodes in one
-     * dense array, node after node with n_components doubles each, so that the
-     * 2^dim or 4^dim nodes of a particle's support are a base index plus
-     * constant strides. The distributed vector of the DoFHandler is used only to
-     * add the contributions of the nodes shared by several ranks (exchange());
-     * on one rank nothing is communicated.
+     * Why blocks and not one triangulation cell per lattice cell: the kernels
+     * never use a cell of deal.II, only the lattice; a refined p4est cell costs
+     * about 0.8 kB and 20-40 us to create in 3D, 30x the cost of the lattice's
+     * own arrays, and would make the set-up of a large grid follow the
+     * triangulation (doc/mpm.md, "Memory and set-up").
+     *
+     * Each rank keeps the nodal data of the nodes its points can reach -- the
+     * nodes of its own blocks' cells plus `margin` node layers around them (a
+     * point's support reaches one node beyond its cell with the cubic basis) --
+     * in one dense array over the lattice box that holds them, node after node
+     * with n_components doubles each, so that a point's 2^dim or 4^dim support
+     * nodes are a base index plus constant strides. No array or loop of the set-up
+     * or of a step is over the whole lattice.
+     *
+     * Nodes shared by several ranks are added up through a
+     * LinearAlgebra::distributed::Vector: each lattice node is owned by the
+     * owner of its block (the block that holds the cell above it, the last one
+     * at the upper faces), the owned nodes are numbered rank by rank, and the
+     * ranks that reach a node hold it as a ghost (exchange()). On one rank
+     * nothing is communicated.
      */
     template <int dim>
     class BackgroundGrid
@@ -39,18 +55,74 @@ namespace hysteron
     public:
       explicit BackgroundGrid(MPI_Comm comm);
 
+      /// Lattice cells per block side (64 cells a block in 2D, 512 in 3D).
+      static constexpr unsigned int
+      block_size()
+      {
+        return 8;
+      }
+
+      /// A block's data in a checkpoint (or moving with it to another rank).
+      using BlockPacker = std::function<std::vector<char>(const std::array<unsigned int, dim> &block)>;
+      using BlockUnpacker =
+        std::function<void(const std::array<unsigned int, dim>                              &block,
+                           const boost::iterator_range<std::vector<char>::const_iterator> &data)>;
+
       /**
-       * Create the grid: cells of size @p h from @p lower; @p n_cells per
-       * direction; @p n_components doubles per node. With @p work_per_cell (in
-       * lattice order, e.g. the material points of each cell) p4est balances
-       * that work instead of the number of cells between the ranks.
+       * Create the lattice (cells of size @p h from @p lower, @p n_cells per
+       * direction) and the triangulation of its blocks (a coarse mesh of few
+       * cells refined to the blocks, so that p4est holds them distributed),
+       * partitioned into equal numbers of blocks. A point reaches @p margin node
+       * layers beyond its cell's own nodes (0: linear basis, 1: cubic B-splines).
        */
       void
-      initialize(const dealii::Point<dim>            &lower,
-                 const double                          h,
-                 const std::array<unsigned int, dim> &n_cells,
-                 const unsigned int                    n_components,
-                 const std::vector<unsigned int>      &work_per_cell = {});
+      create(const dealii::Point<dim>            &lower,
+             const double                          h,
+             const std::array<unsigned int, dim> &n_cells,
+             const unsigned int                    margin);
+
+      /**
+       * Save the triangulation into @p file (p4est's files) with @p pack's data of
+       * every locally owned block (collective): what load() reads on any number
+       * of ranks.
+       */
+      void
+      save(const std::string &file, const BlockPacker &pack);
+
+      /**
+       * create() from a checkpoint: the same lattice, the blocks partitioned as
+       * saved when @p same_ranks (as many ranks as then; else in equal numbers),
+       * and @p unpack called with the data of every locally owned block.
+       * Collective.
+       */
+      void
+      load(const dealii::Point<dim>            &lower,
+           const double                          h,
+           const std::array<unsigned int, dim> &n_cells,
+           const unsigned int                    margin,
+           const std::string                    &file,
+           const bool                            same_ranks,
+           const BlockUnpacker                  &unpack);
+
+      /**
+       * Repartition the blocks so that the ranks get equal sums of @p weight
+       * (of a locally owned block's multi-index; blocks outside the lattice
+       * weigh nothing). With @p pack, the blocks' data moves with them and
+       * arrives through @p unpack on the new owners. Collective; a no-op on one
+       * rank.
+       */
+      void
+      repartition(const std::function<unsigned int(const std::array<unsigned int, dim> &)> &weight,
+                  const BlockPacker   &pack   = {},
+                  const BlockUnpacker &unpack = {});
+
+      /**
+       * After the last (re)partition: the box of nodes this rank reaches, which
+       * of them it owns, and the exchange of the shared nodes; @p n_components
+       * doubles per node.
+       */
+      void
+      setup_nodes(const unsigned int n_components);
 
       /// The lattice of the current step (moved by move() if the grid moves).
       const Lattice<dim> &
@@ -130,16 +202,63 @@ namespace hysteron
         return id;
       }
 
-      /// Is the lattice cell @p id locally owned?
-      bool
-      owns_cell(const unsigned int id) const
+      /// The block of the lattice cell @p c.
+      std::array<unsigned int, dim>
+      block_of(const std::array<unsigned int, dim> &c) const
       {
-        return owned_cell[id] != 0;
+        std::array<unsigned int, dim> b;
+        for (unsigned int d = 0; d < dim; ++d)
+          b[d] = c[d] / block_size();
+        return b;
       }
 
-      /// The active cell of the triangulation that is lattice cell @p id (locally owned).
+      /// Is the block @p b locally owned?
+      bool
+      owns_block(const std::array<unsigned int, dim> &b) const
+      {
+        const int k = local_block(b);
+        return k >= 0 && block_state[k] == owned_block;
+      }
+
+      /// Is the lattice cell @p c locally owned (in a locally owned block)?
+      bool
+      owns_cell(const std::array<unsigned int, dim> &c) const
+      {
+        return owns_block(block_of(c));
+      }
+
+      /// The range [first, last] of lattice cells in this rank's blocks (a box that
+      /// may hold other ranks' cells too; empty if first > last).
+      std::pair<std::array<unsigned int, dim>, std::array<unsigned int, dim>>
+      owned_cell_range() const
+      {
+        return owned_range;
+      }
+
+      /// The locally owned blocks (multi-indices) in the order of p4est's space-filling
+      /// curve, which is the order of the ranks' parts.
+      const std::vector<std::array<unsigned int, dim>> &
+      owned_blocks() const
+      {
+        return owned_block_list;
+      }
+
+      /// The active cell of the triangulation that is the (locally owned) block of lattice cell @p c.
       typename dealii::Triangulation<dim>::active_cell_iterator
-      cell_iterator(const unsigned int id) const;
+      cell_iterator(const std::array<unsigned int, dim> &c) const;
+
+      /// The coordinates of @p x in the unit cell of the block of the lattice cell @p c
+      /// (lattice coordinates: the same in every frame of a moving grid).
+      dealii::Point<dim>
+      unit_block_point(const dealii::Point<dim> &x, const std::array<unsigned int, dim> &c) const
+      {
+        const auto         b = block_of(c);
+        dealii::Point<dim> r;
+        for (unsigned int d = 0; d < dim; ++d)
+          r[d] = ((x[d] - grid_lattice.origin[d]) / grid_lattice.h[d] - double(b[d]) * block_size()) /
+                 block_size();
+        return r;
+      }
 
       /// Number of nodes of the local dense box.
       unsigned int
@@ -186,7 +305,7 @@ namespace hysteron
       dealii::Point<dim>
       node_position(const unsigned int n) const;
 
-      /// Is local node @p n one of the grid's locally relevant nodes?
+      /// Can a point of this rank reach local node @p n (a node of its blocks or their margin)?
       bool
       is_relevant(const unsigned int n) const
       {
@@ -250,26 +369,28 @@ namespace hysteron
         return n_ranks > 1;
       }
 
+      /// Bytes of the grid's own arrays on this rank (nodes, flags, exchange lists).
+      std::size_t
+      memory_consumption() const;
+
     private:
       /**
-       * The DoFs of one nodal array (n_comp FE_Q(1) per node) and, for the
-       * nodes shared with other ranks, (local box node, local vector index of
-       * component 0): what exchange() needs.
+       * The exchange of one nodal array (n_comp doubles per node): a distributed
+       * vector over the owned nodes with the other reached nodes as ghosts, and
+       * (local box node, local vector index of component 0) of the ghosts and of
+       * the owned nodes that other ranks reach.
        */
       struct Field
       {
         unsigned int                                       n_comp = 0;
-        std::unique_ptr<dealii::FESystem<dim>>             fe;
-        dealii::DoFHandler<dim>                            dof_handler;
         dealii::LinearAlgebra::distributed::Vector<double> buffer;
         std::vector<std::pair<unsigned int, unsigned int>> ghost_nodes;
         std::vector<std::pair<unsigned int, unsigned int>> import_nodes;
       };
 
-      /// Distribute the field's DoFs and list its shared nodes (with @p set_node_flags
-      /// also which nodes are relevant and owned).
+      /// The partitioner of @p field from the node numbering (several ranks only).
       void
-      connect(Field &field, const bool set_node_flags);
+      connect(Field &field) const;
 
       /// Add up the blocks' components [first, first + n) of @p values at the shared nodes.
       void
@@ -280,15 +401,84 @@ namespace hysteron
                  const unsigned int   n_blocks,
                  const unsigned int   block_size);
 
+      /// The index of block @p b in the local block box, or -1 outside it.
+      int
+      local_block(const std::array<unsigned int, dim> &b) const
+      {
+        int k = 0;
+        for (int d = dim - 1; d >= 0; --d)
+          {
+            const int i = static_cast<int>(b[d]) - block_box_low[d];
+            if (i < 0 || i >= static_cast<int>(block_box_size[d]))
+              return -1;
+            k = k * block_box_size[d] + i;
+          }
+        return k;
+      }
+
+      /// The block of the triangulation cell @p cell (from its centre).
+      std::array<unsigned int, dim>
+      block_of_cell(const typename dealii::Triangulation<dim>::cell_iterator &cell) const;
+
+      /// Is the block @p b one of the lattice's (not one of the triangulation's padding)?
+      bool
+      in_lattice(const std::array<unsigned int, dim> &b) const
+      {
+        for (unsigned int d = 0; d < dim; ++d)
+          if (b[d] >= n_blocks[d])
+            return false;
+        return true;
+      }
+
+      /// The blocks of this rank and their neighbours (states and triangulation cells).
+      void
+      setup_blocks();
+
+      /// Register the blocks' data with the triangulation before a save or repartition:
+      /// each block's partition weight and @p pack's data. Returns the two handles.
+      std::pair<unsigned int, unsigned int>
+      attach(const BlockPacker &pack);
+
+      /// After a load or repartition: the blocks' weights, and their data to @p unpack.
+      void
+      receive(const std::pair<unsigned int, unsigned int> &handles, const BlockUnpacker &unpack);
+
+      /// The lattice and the unrefined coarse mesh of its blocks.
+      void
+      make_coarse_mesh(const dealii::Point<dim>            &lower,
+                       const double                          h,
+                       const std::array<unsigned int, dim> &n_cells,
+                       const unsigned int                    margin);
+
+      /// The owned nodes' global numbers and the ghosts' (asked from their owners).
+      void
+      number_nodes();
+
       MPI_Comm                                          comm;
       unsigned int                                      n_ranks;
       dealii::parallel::distributed::Triangulation<dim> tria;
       Lattice<dim>                                      grid_lattice, initial_lattice;
+      unsigned int                                      margin = 0;
+      /// The refinements from the coarse mesh to the blocks.
+      unsigned int                                      coarse_level = 0;
       unsigned int                                      n_comp = 0;
 
-      /// Per lattice cell: owned (1) or not (0); the triangulation index of the cell.
-      std::vector<unsigned char> owned_cell;
-      std::vector<int>           cell_index;
+      /// Blocks of lattice cells per direction (the triangulation may have more: padding).
+      std::array<unsigned int, dim> n_blocks{};
+
+      /// The weight of each owned block in the last repartition (none: equal numbers).
+      std::map<std::array<unsigned int, dim>, unsigned int> block_weight;
+
+      /// The box of the blocks this rank owns or sees as ghosts: their state and the
+      /// triangulation cell (level, index) of each.
+      static constexpr unsigned char            no_block = 0, owned_block = 1, ghost_block = 2;
+      std::array<int, dim>                      block_box_low{};
+      std::array<unsigned int, dim>             block_box_size{};
+      std::vector<unsigned char>                block_state;
+      std::vector<unsigned int>                 block_owner;
+      std::vector<std::pair<int, int>>          block_cell;
+      std::vector<std::array<unsigned int, dim>> owned_block_list;
+      std::pair<std::array<unsigned int, dim>, std::array<unsigned int, dim>> owned_range;
 
       std::array<int, dim>          box_low;
       std::array<unsigned int, dim> box_size;
@@ -297,7 +487,13 @@ namespace hysteron
       std::vector<unsigned char>    relevant_node;
       std::vector<unsigned char>    owned_node;
       std::vector<double>           nodes;
-      Field                         main;
+
+      /// Several ranks: the global number of each owned node (box order) and of each
+      /// ghost node (the reached nodes this rank does not own), by box node.
+      std::vector<std::pair<unsigned int, unsigned int>> owned_numbers, ghost_numbers;
+      std::uint64_t                                      n_global_nodes = 0;
+      unsigned int                                       first_owned_number = 0;
+      Field                                              main;
 
       /// The optional second array (initialize_layer()).
       std::vector<double> layer_nodes;

@@ -333,13 +333,14 @@ namespace hysteron
       left_subdomain = false;
       for (unsigned int p = 0; p < P.size(); ++p)
         {
-          const unsigned int id = grid->cell_id(moved.cell_of(P.current.x[p]));
+          const auto         cell = moved.cell_of(P.current.x[p]);
+          const unsigned int id   = grid->cell_id(cell);
           if (id != particles.cell[p])
             {
               particles.cell[p] = id;
               ++n_changed_cells;
             }
-          left_subdomain = left_subdomain || !grid->owns_cell(id);
+          left_subdomain = left_subdomain || !grid->owns_cell(cell);
         }
     }
 

@@ -72,6 +72,15 @@ namespace hysteron
                             "0.1",
                             Patterns::Double(),
                             "Edge length h of the square (cubic) grid cells [m], > 0.");
+          prm.declare_entry("Cell weight",
+                            "0.1",
+                            Patterns::Double(),
+                            "The work of one grid cell, counted in material points [-], >= 0, "
+                            "when the grid is split between MPI ranks: each rank gets an equal "
+                            "share of (material points + Cell weight x grid cells). 0 balances "
+                            "the points alone (the time of a step: a cell without points costs "
+                            "nothing in a step); larger values also balance the grid's memory "
+                            "and set-up (a grid mostly empty of points).");
           declare_grid_motion_parameters(prm);
         }
         prm.leave_subsection();
@@ -157,6 +166,7 @@ namespace hysteron
         lower     = parse_point<dim>(grid_section.get("Lower corner"), grid_section.where("Lower corner"));
         upper     = parse_point<dim>(grid_section.get("Upper corner"), grid_section.where("Upper corner"));
         cell_size = grid_section.get_positive("Cell size");
+        cell_weight = grid_section.get_non_negative("Cell weight");
         double n_total = 1;
         for (unsigned int d = 0; d < dim; ++d)
           {
@@ -225,15 +235,20 @@ namespace hysteron
                     ring.origin[e] -= cell_size;
                     ring.n_cells[e] += 2;
                   }
-                const auto outside = Geometry::fill<dim>(
-                  body.shape, ring, body.particles_per_cell,
-                  [&](const std::array<unsigned int, dim> &c) {
-                    for (unsigned int e = 0; e < dim; ++e)
-                      if (c[e] == 0 || c[e] == ring.n_cells[e] - 1)
-                        return true;
-                    return false;
-                  });
-                require(outside.empty(),
+                // The ring is 2 dim slabs one cell thick (the work follows the surface).
+                bool outside = false;
+                for (unsigned int e = 0; e < dim && !outside; ++e)
+                  for (const unsigned int side : {0u, ring.n_cells[e] - 1})
+                    {
+                      std::array<unsigned int, dim> first{}, last;
+                      for (unsigned int f = 0; f < dim; ++f)
+                        last[f] = ring.n_cells[f] - 1;
+                      first[e] = last[e] = side;
+                      outside  = outside ||
+                                !Geometry::fill<dim>(body.shape, ring, body.particles_per_cell, first, last)
+                                   .empty();
+                    }
+                require(!outside,
                         "Body " + body.name + "/Shape",
                         std::string("the body reaches outside the grid in ") + component_suffix[d] +
                           " (body from " + std::to_string(box.lower_bound(d)) + " to " +
@@ -372,7 +387,6 @@ namespace hysteron
     Solver<dim>::setup()
     {
       const Scene<dim> &scene = this->get_scene();
-      setup_grid();
       probes.clear();
       for (const auto &p : scene.output_control().probe_points)
         {
@@ -380,8 +394,19 @@ namespace hysteron
           probe.point = p;
           probes.push_back(probe);
         }
-      generate_particles();
-      from_handler();
+      load_per_point.assign(scene.load_descriptions().size() + 1, dealii::Tensor<1, dim>());
+      reactions.assign(scene.boundary_descriptions().size() + scene.body_descriptions().size(),
+                       dealii::Tensor<1, dim>());
+      // The grid and the points: new, or from the checkpoint of --resume (the points go
+      // into the arrays in load(), once the grid is where it was).
+      if (this->resuming())
+        setup_from_checkpoint();
+      else
+        {
+          setup_grid();
+          generate_particles();
+          from_handler();
+        }
       setup_boundaries();
       setup_grid_motion();
       // The smallest mass a node may have and still get a velocity.

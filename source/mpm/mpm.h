@@ -16,6 +16,7 @@
 #include "mpm/particles.h"
 
 #include <cmath>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -122,9 +123,9 @@ namespace hysteron
       void
       finish(double t) override;
       void
-      save(CheckpointWriter &out) const override;
+      save(CheckpointWriter &global, CheckpointWriter &rank, const CheckpointDirectory &directory) const override;
       void
-      load(CheckpointReader &in) override;
+      load(CheckpointReader &global, std::vector<CheckpointReader> &rank_parts, const CheckpointDirectory &directory) override;
 
     private:
       struct BoundaryNodes
@@ -161,6 +162,8 @@ namespace hysteron
       bool                          particle_table = false;
       std::vector<Geometry::Region<dim>> average_regions;
       double                        small_mass = 0; ///< nodes lighter than this have no velocity
+      /// The work of a grid cell, in material points, when p4est balances the ranks.
+      double                        cell_weight = 0.1;
 
       // The moving grid (`MPM/Grid/Motion`, grid_motion.cc). The lattice is moved
       // after every step; the kernels see only the lattice of their step.
@@ -210,10 +213,28 @@ namespace hysteron
       // Set-up and the pieces of run().
       void
       setup_grid();
+      /// The groups of points (a material or a rigid body each) and the ParticleHandler.
+      void
+      setup_groups();
       void
       generate_particles();
       void
       setup_boundaries();
+      /// --resume: the grid and this rank's points (in resumed_points) from the checkpoint.
+      void
+      setup_from_checkpoint();
+      /// --resume: the arrays and the handler from resumed_points; with @p same_order
+      /// (as many ranks as the checkpoint's) in the arrays' order at the checkpoint.
+      void
+      restore_points(const bool same_order);
+      /// The global part (what is the same on every rank) and a rank's part of the
+      /// state, for save() and load() alike.
+      template <class Archive>
+      void
+      serialize_global(Archive &ar);
+      template <class Archive>
+      void
+      serialize_rank(Archive &ar);
       /// "[x0, x1] x [y0, y1]": the extent of @p lattice (the background grid), for messages.
       std::string
       grid_extent(const Lattice<dim> &lattice) const;
@@ -339,12 +360,13 @@ namespace hysteron
               }
             return;
           }
-        const unsigned int id = grid->cell_id(lattice.cell_of(x));
+        const auto         cell = lattice.cell_of(x);
+        const unsigned int id   = grid->cell_id(cell);
         if (id != particles.cell[p])
           {
             particles.cell[p] = id;
             ++n_changed_cells;
-            if (!grid->owns_cell(id))
+            if (!grid->owns_cell(cell))
               left_subdomain = true;
           }
       }
@@ -428,6 +450,8 @@ namespace hysteron
       std::vector<std::string>                      state_names;
       std::vector<unsigned int>                     group_of_body;
       std::vector<std::vector<dealii::Point<dim>>>  body_points; ///< set-up only
+      /// --resume: this rank's points as the checkpoint holds them, by block (set-up to load()).
+      std::map<std::array<unsigned int, dim>, std::vector<char>> resumed_points;
       std::vector<typename ParticleStore<dim>::Group> group_templates;
       unsigned int                                  current_group_key = 0;
       unsigned int                                  n_properties      = 0;

@@ -7,6 +7,10 @@
 #include "mpm/mpm.h"
 
 #include <algorithm>
+#include <climits>
+#include <limits>
+#include <map>
+#include <tuple>
 #include <cmath>
 #include <functional>
 #include <numeric>
@@ -20,6 +24,54 @@ namespace hysteron
     namespace
     {
       const char *const *const component_suffix = PointData::component_names;
+
+      /**
+       * The material point nearest to a probe: this rank's, then all ranks'. Ties go
+       * to the smallest (body, lattice cell id, place in the cell), the order of the
+       * fill, so that the choice is the same on any number of ranks.
+       */
+      template <int dim>
+      struct ProbeCandidate
+      {
+        double                        distance = std::numeric_limits<double>::max();
+        std::array<unsigned int, 3>   order{{UINT_MAX, UINT_MAX, UINT_MAX}};
+        dealii::types::particle_index id = 0;
+        std::array<double, dim>       x{};
+
+        void
+        consider(const double                       r,
+                 const std::array<unsigned int, 3> &o,
+                 const dealii::types::particle_index i,
+                 const dealii::Point<dim>          &p)
+        {
+          if (std::tie(r, o) < std::tie(distance, order))
+            {
+              distance = r;
+              order    = o;
+              id       = i;
+              for (unsigned int d = 0; d < dim; ++d)
+                x[d] = p[d];
+            }
+        }
+
+        ProbeCandidate
+        nearest(const MPI_Comm comm) const
+        {
+          ProbeCandidate result;
+          for (const auto &c : dealii::Utilities::MPI::all_gather(comm, *this))
+            result.consider(c.distance, c.order, c.id, c.position());
+          return result;
+        }
+
+        dealii::Point<dim>
+        position() const
+        {
+          dealii::Point<dim> p;
+          for (unsigned int d = 0; d < dim; ++d)
+            p[d] = x[d];
+          return p;
+        }
+      };
     } // namespace
 
 
@@ -29,47 +81,63 @@ namespace hysteron
     Solver<dim>::setup_grid()
     {
       const Scene<dim> &scene = this->get_scene();
-      // Fill the bodies first (every rank, same order): the points per cell
-      // weigh the cells when p4est partitions them, so that ranks get equal work.
-      Lattice<dim> lattice;
-      lattice.origin  = lower;
-      lattice.h       = uniform_h<dim>(cell_size);
-      lattice.n_cells = n_cells;
-      const Geometry::FillLattice<dim> fill_lattice{lower, cell_size, n_cells};
-      std::vector<unsigned int>        points_per_cell;
-      if (dealii::Utilities::MPI::n_mpi_processes(scene.mpi_communicator()) > 1)
-        points_per_cell.assign(std::accumulate(n_cells.begin(), n_cells.end(), 1u, std::multiplies<>()), 0);
-      body_points.clear();
-      for (const auto &body : scene.body_descriptions())
-        {
-          body_points.push_back(Geometry::fill(body.shape, fill_lattice, body.particles_per_cell));
-          if (!points_per_cell.empty())
-            for (const auto &x : body_points.back())
-              {
-                const auto         c  = lattice.cell_of(x);
-                unsigned int       id = 0;
-                for (int d = dim - 1; d >= 0; --d)
-                  id = id * n_cells[d] + c[d];
-                ++points_per_cell[id];
-              }
-        }
-      // Two bodies in one place would put two material points (twice the mass) there.
+      grid = std::make_unique<BackgroundGrid<dim>>(scene.mpi_communicator());
+      // A point reaches one node beyond its cell with the cubic B-splines (4 per direction).
+      grid->create(lower, cell_size, n_cells, basis_name == "linear" ? 0 : 1);
       const auto &bodies = scene.body_descriptions();
+      const Geometry::FillLattice<dim> fill_lattice{lower, cell_size, n_cells};
+      // The points of this rank's cells (every rank fills only its own part of the lattice).
+      const auto fill_owned = [&](const unsigned int b) {
+        const auto [first, last] = grid->owned_cell_range();
+        for (unsigned int d = 0; d < dim; ++d)
+          if (first[d] > last[d])
+            return std::vector<dealii::Point<dim>>();
+        return Geometry::fill<dim>(bodies[b].shape,
+                                   fill_lattice,
+                                   bodies[b].particles_per_cell,
+                                   first,
+                                   last,
+                                   [&](const std::array<unsigned int, dim> &c) { return grid->owns_cell(c); });
+      };
+      if (grid->is_parallel())
+        {
+          // The work of a block: its material points plus `Cell weight` per grid cell, counted
+          // in the blocks of the first (equal) partition; p4est then balances the work.
+          const Lattice<dim> &lattice = grid->initial_lattice_geometry();
+          std::map<std::array<unsigned int, dim>, double> work;
+          for (unsigned int b = 0; b < bodies.size(); ++b)
+            for (const auto &x : fill_owned(b))
+              work[grid->block_of(lattice.cell_of(x))] += 1.0;
+          grid->repartition([&](const std::array<unsigned int, dim> &block) {
+            double cells = 1;
+            for (unsigned int d = 0; d < dim; ++d)
+              cells *= std::min((block[d] + 1) * grid->block_size(), n_cells[d]) - block[d] * grid->block_size();
+            const auto it = work.find(block);
+            return static_cast<unsigned int>(
+              std::llround(100 * ((it == work.end() ? 0.0 : it->second) + cell_weight * cells)));
+          });
+        }
+      grid->setup_nodes(1 + 2 * dim);
+
+      body_points.clear();
+      for (unsigned int b = 0; b < bodies.size(); ++b)
+        body_points.push_back(fill_owned(b));
+      // Two bodies in one place would put two material points (twice the mass) there.
       for (unsigned int b = 1; b < bodies.size(); ++b)
         for (unsigned int a = 0; a < b; ++a)
           {
-            unsigned long n_inside = 0;
+            unsigned long n_inside = 0, n_points = body_points[b].size();
             for (const auto &x : body_points[b])
               n_inside += bodies[a].shape.contains(x) ? 1 : 0;
+            n_inside = dealii::Utilities::MPI::sum(n_inside, scene.mpi_communicator());
+            n_points = dealii::Utilities::MPI::sum(n_points, scene.mpi_communicator());
             require(n_inside == 0,
                     "Body " + bodies[b].name + "/Shape",
                     "overlaps Body " + bodies[a].name + ": " + std::to_string(n_inside) + " of its " +
-                      std::to_string(body_points[b].size()) +
+                      std::to_string(n_points) +
                       " material points lie inside that body's shape (two bodies in one place would "
                       "double the mass there)");
           }
-      grid = std::make_unique<BackgroundGrid<dim>>(scene.mpi_communicator());
-      grid->initialize(lower, cell_size, n_cells, 1 + 2 * dim, points_per_cell);
       node_stamp.assign(grid->n_local_nodes(), 0);
       rigid_node_body.assign(grid->n_local_nodes(), 0);
       active_nodes.clear();
@@ -80,14 +148,11 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::generate_particles()
+    Solver<dim>::setup_groups()
     {
-      using namespace dealii;
-      using PI              = PropertiesIndex<dim>;
+      using PI                = PropertiesIndex<dim>;
       const Scene<dim> &scene = this->get_scene();
       const auto       &bodies = scene.body_descriptions();
-      const auto       &loads  = scene.load_descriptions();
-
       // Groups: one per material of the deformable bodies, one per rigid body.
       group_of_body.assign(bodies.size(), 0);
       group_templates.clear();
@@ -119,64 +184,115 @@ namespace hysteron
         }
 
       n_properties = PI::n_fixed + particles.n_state_slots;
-      handler      = std::make_unique<Particles::ParticleHandler<dim>>(grid->triangulation(),
-                                                                     mapping,
-                                                                     n_properties);
+      handler      = std::make_unique<dealii::Particles::ParticleHandler<dim>>(grid->triangulation(),
+                                                                             mapping,
+                                                                             n_properties);
+    }
 
-      // Every rank generates all points in the same order (so the ids, load
-      // counts and probe points agree) and keeps those in its own cells.
+
+
+    template <int dim>
+    void
+    Solver<dim>::generate_particles()
+    {
+      using namespace dealii;
+      using PI              = PropertiesIndex<dim>;
+      const Scene<dim> &scene = this->get_scene();
+      const auto       &bodies = scene.body_descriptions();
+      const auto       &loads  = scene.load_descriptions();
+      setup_groups();
+
+      // This rank's points (its cells' part of every body's fill). Their ids are the
+      // same on any number of ranks: body by body, the blocks in the order of p4est's
+      // curve (which is the order of the ranks' parts), within a block the fill's order
+      // (cells lexicographically, then sub-cells), so that within a cell the ids keep
+      // the fill's order.
       const Lattice<dim> &lattice = grid->lattice();
+      const MPI_Comm      comm    = scene.mpi_communicator();
+      std::map<std::array<unsigned int, dim>, unsigned int> block_position;
+      for (const auto &b : grid->owned_blocks())
+        block_position.emplace(b, block_position.size());
+      std::vector<std::uint64_t> count(bodies.size()), first_id(bodies.size(), 0);
+      for (unsigned int b = 0; b < bodies.size(); ++b)
+        count[b] = body_points[b].size();
+      {
+        std::vector<std::uint64_t> before(bodies.size(), 0);
+        int ierr = MPI_Exscan(count.data(), before.data(), bodies.size(), MPI_UINT64_T, MPI_SUM, comm);
+        AssertThrowMPI(ierr);
+        if (Utilities::MPI::this_mpi_process(comm) == 0)
+          std::fill(before.begin(), before.end(), 0);
+        std::vector<std::uint64_t> total(bodies.size());
+        ierr = MPI_Allreduce(count.data(), total.data(), bodies.size(), MPI_UINT64_T, MPI_SUM, comm);
+        AssertThrowMPI(ierr);
+        std::uint64_t offset = 0;
+        for (unsigned int b = 0; b < bodies.size(); ++b)
+          {
+            first_id[b] = offset + before[b];
+            count[b]    = total[b];
+            offset += total[b];
+          }
+        require(offset < std::numeric_limits<types::particle_index>::max(),
+                "Body names",
+                "the bodies hold " + std::to_string(offset) +
+                  " material points, more than this deal.II build's 32-bit particle index allows");
+        n_global_particles = offset;
+      }
+
       load_count.assign(loads.size() + 1, 0);
       load_volume.assign(loads.size() + 1, 0.0);
-      std::vector<double>    properties(n_properties);
-      types::particle_index  next_id = 0;
-      std::vector<double>    best_distance(probes.size(), std::numeric_limits<double>::max());
+      std::vector<double> properties(n_properties);
+      // A probe follows its nearest material point of a deformable body; ties go to the
+      // first in the fill's order (body, cell, place in the cell): the same on any ranks.
+      std::vector<ProbeCandidate<dim>> best(probes.size());
       for (unsigned int b = 0; b < bodies.size(); ++b)
         {
           const auto &body   = bodies[b];
           const auto &points = body_points[b];
-          require(!points.empty(),
+          require(count[b] > 0,
                   "Body " + body.name + "/Shape",
                   "the body holds no material point (points sit at the centres of the " +
                     std::to_string(body.particles_per_cell) + "^" + std::to_string(dim) +
                     " sub-cells of each grid cell: refine the grid or raise `Particles per "
                     "cell`)");
-          const auto  &group     = group_templates[group_of_body[b]];
+          std::vector<unsigned int> order(points.size()), cell_of_point(points.size());
+          std::iota(order.begin(), order.end(), 0u);
+          for (unsigned int i = 0; i < points.size(); ++i)
+            cell_of_point[i] = block_position.at(grid->block_of(lattice.cell_of(points[i])));
+          std::stable_sort(order.begin(), order.end(), [&](const unsigned int i, const unsigned int j) {
+            return cell_of_point[i] < cell_of_point[j];
+          });
+          std::vector<types::particle_index> id(points.size());
+          for (unsigned int k = 0; k < order.size(); ++k)
+            id[order[k]] = first_id[b] + k;
+
+          const auto  &group = group_templates[group_of_body[b]];
           // The point's share of the body: its sub-cell times the thickness there (2D;
           // axisymmetric: times the circumference 2 pi r).
           const double cell_volume = std::pow(cell_size / body.particles_per_cell, dim);
           const double density =
             scene.material(body.material, "Body " + body.name + "/Material").density();
-          for (const auto &x : points)
+          unsigned int previous_cell = std::numeric_limits<unsigned int>::max(), place = 0;
+          for (unsigned int i = 0; i < points.size(); ++i)
             {
-              const types::particle_index id = next_id++;
-              unsigned int                load = 0;
+              const auto        &x    = points[i];
+              const auto         cell = lattice.cell_of(x);
+              const unsigned int cid  = grid->cell_id(cell);
+              place                   = cid == previous_cell ? place + 1 : 0;
+              previous_cell           = cid;
+              unsigned int load       = 0;
               if (!body.rigid)
                 for (unsigned int l = 0; l < loads.size() && load == 0; ++l)
                   if (loads[l].region.contains(x, 1e-9 * cell_size))
                     load = l + 1;
-              // On every rank (the same error everywhere if it is not > 0).
               // Axisymmetric: the ring around the axis, 2 pi r per unit of section area.
               const double thickness = scene.thickness_at(body, x);
               const double volume    = cell_volume * thickness;
               ++load_count[load];
               load_volume[load] += volume;
-              for (unsigned int i = 0; i < probes.size(); ++i)
-                if (!body.rigid)
-                  {
-                    const double distance = x.distance(probes[i].point);
-                    if (distance < best_distance[i])
-                      {
-                        best_distance[i]            = distance;
-                        probes[i].id                = id;
-                        probes[i].initial_position = x;
-                      }
-                  }
+              if (!body.rigid)
+                for (unsigned int p = 0; p < probes.size(); ++p)
+                  best[p].consider(x.distance(probes[p].point), {{b, cid, place}}, id[i], x);
 
-              const auto         cell = lattice.cell_of(x);
-              const unsigned int cid  = grid->cell_id(cell);
-              if (!grid->owns_cell(cid))
-                continue;
               std::fill(properties.begin(), properties.end(), 0.0);
               properties[PI::mass]      = density * volume;
               properties[PI::volume0]   = volume;
@@ -194,24 +310,31 @@ namespace hysteron
               if (group.material != nullptr && group.n_state > 0)
                 group.material->initialize_state(
                   view(properties.data() + PI::n_fixed, group.n_state));
-              insert_into_handler(x, id, make_array_view(std::as_const(properties)));
+              insert_into_handler(x, id[i], make_array_view(std::as_const(properties)));
             }
         }
-      // A probe follows its nearest material point; a point farther than a grid
-      // cell diagonal from every one of them lies outside the deformable bodies.
-      for (unsigned int i = 0; i < probes.size(); ++i)
-        if (!(best_distance[i] <= std::sqrt(double(dim)) * cell_size))
-          {
-            std::ostringstream what;
-            what << "the point (" << probes[i].point << ") lies outside the deformable bodies: ";
-            if (best_distance[i] < std::numeric_limits<double>::max())
-              what << "the nearest material point is " << best_distance[i] << " m away (more than a grid "
-                   << "cell diagonal, " << std::sqrt(double(dim)) * cell_size << " m)";
-            else
-              what << "the scene has no deformable body";
-            throw InputError("Output/Probe points", what.str());
-          }
-      n_global_particles = next_id;
+      Utilities::MPI::sum(make_array_view(std::as_const(load_count)), comm, make_array_view(load_count));
+      Utilities::MPI::sum(make_array_view(std::as_const(load_volume)), comm, make_array_view(load_volume));
+      // A probe follows its nearest material point; a point farther than a grid cell
+      // diagonal from every one of them lies outside the deformable bodies.
+      for (unsigned int p = 0; p < probes.size(); ++p)
+        {
+          const ProbeCandidate<dim> nearest = best[p].nearest(comm);
+          if (!(nearest.distance <= std::sqrt(double(dim)) * cell_size))
+            {
+              std::ostringstream what;
+              what << "the point (" << probes[p].point << ") lies outside the deformable bodies: ";
+              if (nearest.distance < std::numeric_limits<double>::max())
+                what << "the nearest material point is " << nearest.distance
+                     << " m away (more than a grid cell diagonal, " << std::sqrt(double(dim)) * cell_size
+                     << " m)";
+              else
+                what << "the scene has no deformable body";
+              throw InputError("Output/Probe points", what.str());
+            }
+          probes[p].id               = nearest.id;
+          probes[p].initial_position = nearest.position();
+        }
       body_points.clear();
       body_points.shrink_to_fit();
       handler->update_cached_numbers();
@@ -219,8 +342,6 @@ namespace hysteron
         require(load_count[l] > 0,
                 "Load " + loads[l - 1].name + "/Region",
                 "the region contains no material point of a deformable body");
-      load_per_point.assign(loads.size() + 1, Tensor<1, dim>());
-      reactions.assign(scene.boundary_descriptions().size() + bodies.size(), Tensor<1, dim>());
     }
 
 
@@ -387,15 +508,10 @@ namespace hysteron
                                      const dealii::ArrayView<const double> &properties)
     {
       // The triangulation has the set-up's geometry: the point goes where its lattice
-      // coordinates lie there (the same cell, the same unit-cell coordinates).
-      const auto         cell = grid->lattice().cell_of(x);
-      const unsigned int cid  = grid->cell_id(cell);
-      const dealii::Point<dim> y = grid_moves ? grid->to_initial_frame(x) : x;
-      handler->insert_particle(y,
-                               grid->lattice().unit_cell_point(x, cell),
-                               id,
-                               grid->cell_iterator(cid),
-                               properties);
+      // coordinates lie there (the same block, the same coordinates in it).
+      const auto               cell = grid->lattice().cell_of(x);
+      const dealii::Point<dim> y    = grid_moves ? grid->to_initial_frame(x) : x;
+      handler->insert_particle(y, grid->unit_block_point(x, cell), id, grid->cell_iterator(cell), properties);
     }
 
 
@@ -509,6 +625,8 @@ namespace hysteron
 
     template void Solver<2>::setup_grid();
     template void Solver<3>::setup_grid();
+    template void Solver<2>::setup_groups();
+    template void Solver<3>::setup_groups();
     template void Solver<2>::generate_particles();
     template void Solver<3>::generate_particles();
     template void Solver<2>::from_handler();

@@ -61,7 +61,7 @@ namespace hysteron
           out.put(assembled_tangent);
           out.put(matrix_values());
         }
-      tables.save(out);
+      const_cast<PointData::Tables<dim> &>(tables).serialize(out);
     }
 
 
@@ -135,7 +135,7 @@ namespace hysteron
             throw RuntimeError("the checkpoint's assembled tangent does not match the network");
           set_matrix_values(values);
         }
-      tables.load(in);
+      tables.serialize(in);
     }
 
 

@@ -1052,16 +1052,22 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::save(CheckpointWriter &out) const
+    Solver<dim>::save(CheckpointWriter &, CheckpointWriter &rank, const CheckpointDirectory &) const
     {
-      model->save(out);
+      model->save(rank);
     }
 
     template <int dim>
     void
-    Solver<dim>::load(CheckpointReader &in)
+    Solver<dim>::load(CheckpointReader &,
+                      std::vector<CheckpointReader> &rank_parts,
+                      const CheckpointDirectory     &directory)
     {
-      model->load(in);
+      if (!directory.same_ranks())
+        throw InputError("--resume",
+                         "the rbsn method resumes on as many MPI ranks as wrote the checkpoint (" +
+                           std::to_string(directory.saved_ranks) + ")");
+      model->load(rank_parts[0]);
     }
 
     template <int dim>

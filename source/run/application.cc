@@ -13,6 +13,7 @@
 
 #include "run/parameter_file.h"
 
+#include <algorithm>
 #include <dlfcn.h>
 #include <filesystem>
 #include <memory>
@@ -76,6 +77,7 @@ namespace hysteron
     {
       unsigned int             dimension = 2;
       SceneNames               names;
+      std::vector<std::string> inputs; ///< the parameter file, its includes, libraries
     };
 
     /// Parse @p file into @p prm (deal.II's errors at the file and line they concern).
@@ -104,6 +106,10 @@ namespace hysteron
       Preamble p;
       p.dimension      = prm.get_integer("Dimension");
       p.names     = SceneNames::read(prm);
+      // The parameter file and its includes: inputs of the run.
+      for (const auto &origin : file.origin)
+        if (std::find(p.inputs.begin(), p.inputs.end(), origin.first) == p.inputs.end())
+          p.inputs.push_back(origin.first);
       for (const auto &library : dealii::Utilities::split_string_list(
              prm.get("Additional shared libraries"), ','))
         if (!library.empty())
@@ -113,6 +119,7 @@ namespace hysteron
             if (dlopen(library.c_str(), RTLD_NOW | RTLD_GLOBAL) == nullptr)
               throw InputError("Additional shared libraries",
                                "cannot load '" + library + "': " + dlerror());
+            p.inputs.push_back(library);
           }
       return p;
     }
@@ -202,6 +209,7 @@ namespace hysteron
           check_readable(files[0]);
           file     = Run::ParameterFile::read(files[0]);
           preamble = read_preamble(file);
+          options.input_files = preamble.inputs;
         }
       else if (!print_parameters)
         throw InputError("command line", "no parameter file given\n" + std::string(usage_text));

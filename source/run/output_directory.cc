@@ -306,6 +306,15 @@ namespace hysteron
         << "  \"started\": " << json(started) << ",\n";
       if (!resumed.empty())
         m << "  \"resumed\": " << json(resumed) << ",\n";
+      m << "  \"inputs\": [\n";
+      for (std::size_t k = 0; k < run.inputs.size(); ++k)
+        {
+          char crc[16];
+          std::snprintf(crc, sizeof(crc), "%08x", run.inputs[k].crc);
+          m << "    {\"path\": " << json(run.inputs[k].path) << ", \"bytes\": " << run.inputs[k].bytes
+            << ", \"crc32\": " << json(crc) << "}" << (k + 1 < run.inputs.size() ? ",\n" : "\n");
+        }
+      m << "  ],\n";
       m << "  \"status\": " << json(status) << ",\n"
         << "  \"message\": " << json(message) << ",\n"
         << "  \"files\": [\n";

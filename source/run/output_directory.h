@@ -3,6 +3,8 @@
 
 #include <mpi.h>
 
+#include <hysteron/base/checkpoint.h>
+
 #include <string>
 
 namespace hysteron
@@ -16,6 +18,7 @@ namespace hysteron
       std::string parameter_file;
       std::string method;
       unsigned int n_ranks = 1;
+      std::vector<FileDigest> inputs; ///< the files the run read, as it read them
     };
 
     /**

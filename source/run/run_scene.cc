@@ -9,6 +9,8 @@
 #include "run/checkpoint_files.h"
 #include "run/output_directory.h"
 
+#include <iostream>
+
 namespace hysteron
 {
   namespace Run
@@ -33,9 +35,20 @@ namespace hysteron
                   options.resume ? "--resume" : "Checkpoint",
                   "method '" + name + "': " + why);
         }
+      // The inputs as read (their digests go into the manifest and every checkpoint); a
+      // resume takes the newest intact checkpoint of the same scene and inputs, found
+      // before the set-up so that the method can build from it.
+      const auto          inputs = digest_inputs(scene.input_files(), comm);
+      CheckpointDirectory resume_point;
       if (options.resume)
-        // A missing or foreign checkpoint is refused before the set-up.
-        open_resume(method.output_directory(), name, scene.effective_parameters(), comm);
+        {
+          const auto checkpoint =
+            find_resumable_checkpoint(method.output_directory(), name, scene.effective_parameters(), inputs, comm, std::cerr);
+          resume_point.path        = checkpoint.directory;
+          resume_point.saved_ranks = checkpoint.ranks;
+          resume_point.n_ranks     = dealii::Utilities::MPI::n_mpi_processes(comm);
+        }
+      method.set_run_context(inputs, resume_point);
 
       dealii::Timer wall;
       wall.start();
@@ -62,6 +75,7 @@ namespace hysteron
       description.parameter_file = options.parameter_file;
       description.method         = name;
       description.n_ranks        = dealii::Utilities::MPI::n_mpi_processes(comm);
+      description.inputs         = inputs;
       OutputDirectory directory;
       directory.open(directory_name, description, options.resume, comm);
       if (scene.is_root())

@@ -120,25 +120,29 @@ namespace hysteron
       const Scene<dim> &scene = this->get_scene();
       auto             &record = Output::RunRecord::get();
       dealii::TimerOutput::Scope timing(scene.timer(), "checkpoint");
-      record.flush_tables();
-      const auto sizes = record.table_sizes();
-      const double t   = loop->time;
+      // The tables' rows up to here are on disk before the checkpoint that counts them.
+      record.sync_tables();
+      const auto   sizes = record.table_sizes();
+      const double t     = loop->time;
       write_checkpoint(this->output_directory(),
                        steps,
                        t,
                        scene.mpi_communicator(),
                        scene.checkpoint_control().keep,
-                       [&](CheckpointWriter &out) {
-                         write_resume_header(out, scene.method_name(), scene.effective_parameters());
-                         out.put(t);
-                         out.put(steps);
-                         out.put(outputs);
-                         out.put(loop->rows.next_time());
-                         out.put(loop->fields.next_time());
-                         out.put(field_writer->records());
-                         out.put(sizes);
-                         out.section(label());
-                         save(out);
+                       sizes,
+                       this->inputs(),
+                       [&](CheckpointWriter &global, CheckpointWriter &rank, const CheckpointDirectory &directory) {
+                         write_resume_header(global, scene.method_name(), scene.effective_parameters());
+                         global.put(t);
+                         global.put(steps);
+                         global.put(outputs);
+                         global.put(loop->rows.next_time());
+                         global.put(loop->fields.next_time());
+                         global.put(field_writer->records());
+                         global.put(sizes);
+                         global.section(label());
+                         rank.section(label());
+                         save(global, rank, directory);
                        });
       loop->last_checkpoint = loop->wall.wall_time();
     }
@@ -199,23 +203,27 @@ namespace hysteron
 
       // Resume: the driver's part of the checkpoint comes first, since the tables
       // must know their lengths before the method opens them.
-      ResumeSource resume;
+      std::unique_ptr<CheckpointParts> resume;
       std::vector<std::pair<double, std::string>> field_records;
-      if (scene.resume())
+      if (this->resuming())
         {
-          resume = open_resume(directory, scene.method_name(), scene.effective_parameters(), comm);
-          auto &reader = resume.reader;
-          reader->get(t);
-          reader->get(steps);
-          reader->get(outputs);
+          resume       = std::make_unique<CheckpointParts>(this->resume_from(), comm);
+          auto &reader = resume->global();
+          std::string method, parameters;
+          reader.section("driver");
+          reader.get(method);
+          reader.get(parameters);
+          reader.get(t);
+          reader.get(steps);
+          reader.get(outputs);
           double next_row, next_field;
-          reader->get(next_row);
-          reader->get(next_field);
+          reader.get(next_row);
+          reader.get(next_field);
           loop->rows.restart(next_row);
           loop->fields.restart(next_field);
-          reader->get(field_records);
+          reader.get(field_records);
           std::map<std::string, std::uint64_t> sizes;
-          reader->get(sizes);
+          reader.get(sizes);
           record.set_resume_sizes(sizes);
         }
 
@@ -223,13 +231,23 @@ namespace hysteron
       field_writer = std::make_unique<Output::FieldWriter>(directory, field_name(), comm);
       record.set_resume_sizes({});
       loop->time = t;
-      if (auto &reader = resume.reader)
+      if (resume)
         {
           field_writer->restore(field_records);
-          reader->section(name);
-          load(*reader);
-          scene.console() << name << ": resumed from " << resume.file.directory << " at t = "
-                          << seconds(t) << " s (step " << steps << ")" << std::endl;
+          resume->global().section(name);
+          for (auto &part : resume->ranks())
+            part.section(name);
+          load(resume->global(), resume->ranks(), this->resume_from());
+          if (!resume->global().at_end())
+            resume->global().refuse("the checkpoint holds more than this scene reads");
+          scene.console() << name << ": resumed from " << this->resume_from().path << " at t = "
+                          << seconds(t) << " s (step " << steps << ")"
+                          << (this->resume_from().same_ranks() ?
+                                std::string() :
+                                ", written on " + std::to_string(this->resume_from().saved_ranks) +
+                                  " MPI rank(s), now on " + std::to_string(this->resume_from().n_ranks))
+                          << std::endl;
+          resume.reset();
         }
       else
         {

@@ -456,10 +456,30 @@ namespace hysteron
   Scene<dim>::resolve_input_file(const std::string &name) const
   {
     std::error_code ec;
-    if (name.empty() || std::filesystem::exists(name, ec) || std::filesystem::path(name).is_absolute())
-      return name;
-    const auto beside = std::filesystem::path(options.parameter_file).parent_path() / name;
-    return std::filesystem::exists(beside, ec) ? beside.string() : name;
+    std::string     path = name;
+    if (!name.empty() && !std::filesystem::exists(name, ec) && !std::filesystem::path(name).is_absolute())
+      {
+        const auto beside = std::filesystem::path(options.parameter_file).parent_path() / name;
+        if (std::filesystem::exists(beside, ec))
+          path = beside.string();
+      }
+    if (!path.empty() && std::filesystem::is_regular_file(path, ec) &&
+        std::find(resolved_inputs.begin(), resolved_inputs.end(), path) == resolved_inputs.end())
+      resolved_inputs.push_back(path);
+    return path;
+  }
+
+
+
+  template <int dim>
+  std::vector<std::string>
+  Scene<dim>::input_files() const
+  {
+    std::vector<std::string> files = options.input_files;
+    for (const auto &f : resolved_inputs)
+      if (std::find(files.begin(), files.end(), f) == files.end())
+        files.push_back(f);
+    return files;
   }
 
 

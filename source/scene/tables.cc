@@ -286,29 +286,23 @@ namespace hysteron
 
 
     template <int dim>
+    template <class Archive>
     void
-    Tables<dim>::save(CheckpointWriter &out) const
+    Tables<dim>::serialize(Archive &ar)
     {
-      out.section("tables");
-      out.put(has_written);
-      out.put(last_time);
-      out.put(energy_log.state());
+      ar.section("tables");
+      auto energy = energy_log.state();
+      ar &has_written &last_time &energy;
+      if constexpr (Archive::is_loading)
+        energy_log.restore(energy);
     }
 
 
 
-    template <int dim>
-    void
-    Tables<dim>::load(CheckpointReader &in)
-    {
-      in.section("tables");
-      in.get(has_written);
-      in.get(last_time);
-      energy_log.restore(in.get<std::array<double, 3>>());
-    }
-
-
-
+    template void Tables<2>::serialize(CheckpointWriter &);
+    template void Tables<3>::serialize(CheckpointWriter &);
+    template void Tables<2>::serialize(CheckpointReader &);
+    template void Tables<3>::serialize(CheckpointReader &);
     template class Tables<2>;
     template class Tables<3>;
   } // namespace PointData

@@ -448,12 +448,13 @@ TEST(GeometryFill, DeterministicOrder)
 
 
 
-TEST(GeometryFill, KeepCellAndVisitedCells)
+TEST(GeometryFill, KeepCellRangeAndVisitedCells)
 {
-  const auto     c = parse2("disk(0,0,1)");
-  FillLattice<2> lattice{Point<2>(-2, -2), 0.1, {{40, 40}}};
-  const auto     all  = fill(c, lattice, 2);
-  const auto     even = fill<2>(c, lattice, 2, [](const std::array<unsigned int, 2> &cell) {
+  const auto                    c = parse2("disk(0,0,1)");
+  FillLattice<2>                lattice{Point<2>(-2, -2), 0.1, {{40, 40}}};
+  const std::array<unsigned int, 2> first{{0, 0}}, last{{39, 39}};
+  const auto                    all  = fill(c, lattice, 2);
+  const auto                    even = fill<2>(c, lattice, 2, first, last, [](const std::array<unsigned int, 2> &cell) {
     return cell[0] % 2 == 0;
   });
   std::vector<Point<2>> expected;
@@ -463,11 +464,26 @@ TEST(GeometryFill, KeepCellAndVisitedCells)
   EXPECT_EQ(even, expected);
   EXPECT_LT(even.size(), all.size());
 
+  // A box of cells (one MPI rank's part) gives bit for bit the full fill's points there,
+  // in the same order: the positions come from the whole lattice.
+  const std::array<unsigned int, 2> lo{{13, 21}}, hi{{27, 35}};
+  const auto                        part = fill<2>(c, lattice, 2, lo, hi);
+  expected.clear();
+  for (const auto &p : all)
+    {
+      const auto i = static_cast<unsigned int>(std::floor((p[0] + 2) / 0.1));
+      const auto j = static_cast<unsigned int>(std::floor((p[1] + 2) / 0.1));
+      if (i >= lo[0] && i <= hi[0] && j >= lo[1] && j <= hi[1])
+        expected.push_back(p);
+    }
+  EXPECT_EQ(part, expected);
+  EXPECT_GT(part.size(), 100u);
+
   // Only cells meeting the bounding box [0,1]^2 are visited: 3 x 3 cells of [-10, 20]^2.
   const auto     square = parse2("rectangle(0,0,1,1)");
   FillLattice<2> coarse{Point<2>(-10, -10), 1.0, {{30, 30}}};
   unsigned int   n_visited = 0;
-  const auto     points    = fill<2>(square, coarse, 1, [&](const std::array<unsigned int, 2> &) {
+  const auto     points    = fill<2>(square, coarse, 1, {{0, 0}}, {{29, 29}}, [&](const std::array<unsigned int, 2> &) {
     ++n_visited;
     return true;
   });

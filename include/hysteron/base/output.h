@@ -125,8 +125,9 @@ namespace hysteron
      * at the end of the run; the file never ends inside a row.
      *
      * Every open time table is known to the RunRecord: a checkpoint records the
-     * length of each, and a resumed run (hysteron --resume) cuts each table back
-     * to that length and appends, so that its tables equal an uninterrupted run's.
+     * length and CRC of each (after sync()), and a resumed run (hysteron --resume)
+     * cuts each table back to that length and appends, so that its tables equal
+     * an uninterrupted run's; a table shorter than that is refused, never padded.
      */
     class TimeTable
     {
@@ -151,6 +152,10 @@ namespace hysteron
       /// Write the buffered rows. Throws RuntimeError on an I/O error.
       void
       flush();
+
+      /// flush() and make the rows durable (fsync).
+      void
+      sync();
 
       /// The length of the file once flushed [bytes].
       std::uint64_t

@@ -74,6 +74,11 @@ namespace hysteron
       void
       flush_tables();
 
+      /// Flush every open time table and make its rows durable (fsync): before a
+      /// checkpoint that counts them is published.
+      void
+      sync_tables();
+
       /// The length of every open time table (after flush_tables()), by file path.
       std::map<std::string, std::uint64_t>
       table_sizes() const;

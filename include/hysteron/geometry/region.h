@@ -236,16 +236,19 @@ namespace hysteron
     fill(const Region<dim> &region, const FillLattice<dim> &lattice, unsigned int k);
 
     /**
-     * As above, but only cells for which @p keep_cell(cell index) returns true
-     * are filled (called once per visited cell, e.g. to keep the cells a rank
-     * owns). The order of the kept points is the same as in the full fill.
+     * As above, but only the cells with first[d] <= c[d] <= last[d] (a box of
+     * the lattice, e.g. the cells of one MPI rank) for which @p keep_cell (if
+     * given) returns true. The points are computed from the whole lattice, so
+     * they are bit-identical to the full fill's, and in the same order.
      */
     template <int dim>
     std::vector<dealii::Point<dim>>
-    fill(const Region<dim>                                            &region,
-         const FillLattice<dim>                                       &lattice,
-         unsigned int                                                  k,
-         const std::function<bool(const std::array<unsigned int, dim> &cell)> &keep_cell);
+    fill(const Region<dim>                                                    &region,
+         const FillLattice<dim>                                               &lattice,
+         unsigned int                                                          k,
+         const std::array<unsigned int, dim>                                  &first,
+         const std::array<unsigned int, dim>                                  &last,
+         const std::function<bool(const std::array<unsigned int, dim> &cell)> &keep_cell = {});
 
     /// The volume (h/k)^dim (m^dim) of one point returned by fill().
     template <int dim>

@@ -78,9 +78,9 @@ namespace hysteron
       void
       finish(double t) override;
       void
-      save(CheckpointWriter &out) const override;
+      save(CheckpointWriter &global, CheckpointWriter &rank, const CheckpointDirectory &directory) const override;
       void
-      load(CheckpointReader &in) override;
+      load(CheckpointReader &global, std::vector<CheckpointReader> &rank_parts, const CheckpointDirectory &directory) override;
 
     private:
       std::unique_ptr<Model<dim>> model;

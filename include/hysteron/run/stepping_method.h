@@ -126,13 +126,25 @@ namespace hysteron
         return "";
       }
 
-      /// This rank's state (everything advance() reads), written bit for bit.
+      /**
+       * Write the state (everything advance() reads), bit for bit, into a
+       * checkpoint: @p global what is the same on every rank (rank 0's is kept),
+       * @p rank this rank's own part (its partial sums and the like), and the
+       * distributed state (points, cells) into files of @p directory, in a form
+       * that any number of ranks can read back. Collective.
+       */
       virtual void
-      save(CheckpointWriter &out) const = 0;
+      save(CheckpointWriter &global, CheckpointWriter &rank, const CheckpointDirectory &directory) const = 0;
 
-      /// Read what save() wrote, after setup() and open_outputs() of the same scene.
+      /**
+       * Read what save() wrote, after setup() and open_outputs() of the same
+       * scene (setup() may have built from resume_from() already).
+       * @p rank_parts holds this rank's own part when the run has as many ranks
+       * as the one that wrote the checkpoint (directory.same_ranks()), else the
+       * parts of all the ranks that wrote it, for the method to share out.
+       */
       virtual void
-      load(CheckpointReader &in) = 0;
+      load(CheckpointReader &global, std::vector<CheckpointReader> &rank_parts, const CheckpointDirectory &directory) = 0;
 
       /**
        * What follows every step: table rows and fields when due, progress, the

@@ -3,9 +3,11 @@
 
 #include <deal.II/base/parameter_handler.h>
 
+#include <hysteron/base/checkpoint.h>
 #include <hysteron/base/registry.h>
 
 #include <string>
+#include <vector>
 
 namespace hysteron
 {
@@ -88,6 +90,41 @@ namespace hysteron
         subdirectory = name;
       }
 
+      /**
+       * Set by the runner before setup(): the run's input files as read (their
+       * digests go into every checkpoint), and with `--resume` the checkpoint the
+       * run continues from, found and checked before setup() so that a method
+       * can build its set-up from it (e.g. a triangulation saved with its cells'
+       * data).
+       */
+      void
+      set_run_context(const std::vector<FileDigest> &inputs, const CheckpointDirectory &resume)
+      {
+        input_digests = inputs;
+        resume_point  = resume;
+      }
+
+      /// Whether the run continues from a checkpoint (resume_from()).
+      bool
+      resuming() const
+      {
+        return !resume_point.path.empty();
+      }
+
+      /// The checkpoint of `--resume`.
+      const CheckpointDirectory &
+      resume_from() const
+      {
+        return resume_point;
+      }
+
+      /// The run's input files as read.
+      const std::vector<FileDigest> &
+      inputs() const
+      {
+        return input_digests;
+      }
+
       /// The directory this method writes into.
       std::string
       output_directory() const;
@@ -110,8 +147,10 @@ namespace hysteron
       }
 
     private:
-      const Scene<dim> *scene_ptr = nullptr;
-      std::string       subdirectory;
+      const Scene<dim>       *scene_ptr = nullptr;
+      std::string             subdirectory;
+      std::vector<FileDigest> input_digests;
+      CheckpointDirectory     resume_point;
     };
 
     template <int dim>

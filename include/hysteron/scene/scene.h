@@ -88,6 +88,8 @@ namespace hysteron
     bool        quiet  = false;
     bool        resume = false; ///< --resume: continue from the newest checkpoint
     MPI_Comm    comm  = MPI_COMM_WORLD;
+    /// The files read before the scene: the parameter file, its includes, libraries.
+    std::vector<std::string> input_files;
   };
 
   /**
@@ -278,6 +280,15 @@ namespace hysteron
     std::string
     resolve_input_file(const std::string &name) const;
 
+    /**
+     * Every file the run reads: the parameter file and its includes, the shared
+     * libraries, and each file resolved by resolve_input_file() (meshes,
+     * amplitude tables). Their digests go into the manifest and every
+     * checkpoint; a resume refuses a changed one.
+     */
+    std::vector<std::string>
+    input_files() const;
+
     /// Progress and messages: rank 0 only, silent with --quiet.
     dealii::ConditionalOStream &
     console() const
@@ -319,6 +330,8 @@ namespace hysteron
     unsigned int                                                    seed = 0;
     bool                                                            axisymmetric_ = false;
     std::string                                                     effective_parameters_;
+    /// The files resolve_input_file() returned (inputs of the run).
+    mutable std::vector<std::string>                                resolved_inputs;
     std::unique_ptr<Methods::Interface<dim>>                        method;
   };
 

@@ -85,11 +85,11 @@ namespace hysteron
       void
       flush();
 
-      /// The state between rows (the last row's time, the energy reference).
+      /// The state between rows (the last row's time, the energy reference), for a
+      /// checkpoint (CheckpointWriter) and its resume (CheckpointReader).
+      template <class Archive>
       void
-      save(CheckpointWriter &out) const;
-      void
-      load(CheckpointReader &in);
+      serialize(Archive &ar);
 
     private:
       std::vector<std::unique_ptr<Output::TimeTable>> probe_tables, average_tables;
