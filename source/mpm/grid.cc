@@ -418,13 +418,53 @@ namespace hysteron
     BackgroundGrid<dim>::number_nodes()
     {
       using namespace dealii;
-      // The owned nodes rank by rank, in box order on each.
+      // Only the nodes shared with other ranks go into the exchange's vector (a copy of
+      // every node's values would double the grid's memory): a rank asks the owners of
+      // the nodes it reaches but does not own for their numbers, and each owner numbers
+      // the nodes it was asked for, rank by rank, in box order on each.
       owned_numbers.clear();
       ghost_numbers.clear();
+      const auto lattice_node = [&](const std::array<int, dim> &i) {
+        std::array<unsigned int, dim> u;
+        for (unsigned int d = 0; d < dim; ++d)
+          u[d] = i[d];
+        return grid_lattice.node_number(u);
+      };
+      const auto owner_of = [&](const std::array<int, dim> &i) {
+        std::array<unsigned int, dim> b;
+        for (unsigned int d = 0; d < dim; ++d)
+          b[d] = std::min<unsigned int>(i[d] / block_size(), n_blocks[d] - 1);
+        const int k = local_block(b);
+        AssertThrow(k >= 0 && block_state[k] == ghost_block,
+                    ExcMessage("mpm grid: a reached node's block is not a ghost block"));
+        return block_owner[k];
+      };
+      std::map<unsigned int, std::vector<unsigned int>> asked;
+      std::vector<unsigned int>                         ghost_box_nodes;
       for (unsigned int n = 0; n < n_box_nodes; ++n)
-        if (owned_node[n])
-          owned_numbers.emplace_back(n, owned_numbers.size());
-      const std::uint64_t n_owned = owned_numbers.size();
+        if (relevant_node[n] && !owned_node[n])
+          {
+            const auto i = lattice_index(n);
+            asked[owner_of(i)].push_back(lattice_node(i));
+            ghost_box_nodes.push_back(n);
+          }
+      const auto answers = Utilities::MPI::some_to_some(comm, asked);
+      const auto box_node_of = [&](const unsigned int node) {
+        const auto           u = grid_lattice.node_index(node);
+        std::array<int, dim> i;
+        for (unsigned int d = 0; d < dim; ++d)
+          i[d] = u[d];
+        const unsigned int n = local_node(i);
+        AssertThrow(owned_node[n], ExcMessage("mpm grid: a node asked for is not owned here"));
+        return n;
+      };
+      std::vector<unsigned int> shared;
+      for (const auto &[rank, list] : answers)
+        for (const unsigned int node : list)
+          shared.push_back(box_node_of(node));
+      std::sort(shared.begin(), shared.end());
+      shared.erase(std::unique(shared.begin(), shared.end()), shared.end());
+      const std::uint64_t n_owned = shared.size();
       std::uint64_t       first   = 0;
       const int ierr = MPI_Exscan(&n_owned, &first, 1, MPI_UINT64_T, MPI_SUM, comm);
       AssertThrowMPI(ierr);
@@ -432,49 +472,17 @@ namespace hysteron
         first = 0;
       n_global_nodes     = Utilities::MPI::sum(n_owned, comm);
       first_owned_number = static_cast<unsigned int>(first);
-      for (auto &o : owned_numbers)
-        o.second += first_owned_number;
-
-      // The ghosts' numbers, asked from their owners (the owners of neighbouring blocks).
-      const auto lattice_node = [&](const std::array<int, dim> &i) {
-        std::array<unsigned int, dim> u;
-        for (unsigned int d = 0; d < dim; ++d)
-          u[d] = i[d];
-        return grid_lattice.node_number(u);
-      };
-      std::map<unsigned int, std::vector<unsigned int>> asked;
-      std::vector<unsigned int>                         ghost_box_nodes;
-      for (unsigned int n = 0; n < n_box_nodes; ++n)
-        if (relevant_node[n] && !owned_node[n])
-          {
-            const auto                    i = lattice_index(n);
-            std::array<unsigned int, dim> b;
-            for (unsigned int d = 0; d < dim; ++d)
-              b[d] = std::min<unsigned int>(i[d] / block_size(), n_blocks[d] - 1);
-            const int k = local_block(b);
-            AssertThrow(k >= 0 && block_state[k] == ghost_block,
-                        ExcMessage("mpm grid: a reached node's block is not a ghost block"));
-            asked[block_owner[k]].push_back(lattice_node(i));
-            ghost_box_nodes.push_back(n);
-          }
-      std::vector<unsigned int> owned_number_of_box(0);
-      const auto                answers = Utilities::MPI::some_to_some(comm, asked);
+      for (unsigned int k = 0; k < shared.size(); ++k)
+        owned_numbers.emplace_back(shared[k], first_owned_number + k);
       std::map<unsigned int, std::vector<unsigned int>> replies;
       for (const auto &[rank, list] : answers)
         {
           auto &reply = replies[rank];
           for (const unsigned int node : list)
             {
-              const auto           u = grid_lattice.node_index(node);
-              std::array<int, dim> i;
-              for (unsigned int d = 0; d < dim; ++d)
-                i[d] = u[d];
-              const unsigned int n  = local_node(i);
-              const auto         it = std::lower_bound(owned_numbers.begin(),
+              const auto it = std::lower_bound(owned_numbers.begin(),
                                                owned_numbers.end(),
-                                               std::make_pair(n, 0u));
-              AssertThrow(it != owned_numbers.end() && it->first == n,
-                          ExcMessage("mpm grid: a node asked for is not owned here"));
+                                               std::make_pair(box_node_of(node), 0u));
               reply.push_back(it->second);
             }
         }
@@ -483,11 +491,7 @@ namespace hysteron
       std::map<unsigned int, std::size_t> next;
       for (const unsigned int n : ghost_box_nodes)
         {
-          const auto                    i = lattice_index(n);
-          std::array<unsigned int, dim> b;
-          for (unsigned int d = 0; d < dim; ++d)
-            b[d] = std::min<unsigned int>(i[d] / block_size(), n_blocks[d] - 1);
-          const unsigned int rank = block_owner[local_block(b)];
+          const unsigned int rank = owner_of(lattice_index(n));
           ghost_numbers.emplace_back(n, numbers.at(rank)[next[rank]++]);
         }
     }
@@ -499,6 +503,10 @@ namespace hysteron
     BackgroundGrid<dim>::connect(Field &field) const
     {
       using namespace dealii;
+      field.ghost_nodes.clear();
+      field.import_nodes.clear();
+      if (n_global_nodes == 0)
+        return; // no node is shared: nothing to exchange (and no vector of size 0)
       const std::uint64_t size = n_global_nodes * field.n_comp;
       AssertThrow(size < std::numeric_limits<types::global_dof_index>::max(),
                   ExcMessage("mpm grid: " + std::to_string(n_global_nodes) + " nodes x " +
@@ -517,12 +525,10 @@ namespace hysteron
       field.buffer.reinit(owned, ghosts, comm);
       const auto &partitioner = *field.buffer.get_partitioner();
 
-      field.ghost_nodes.clear();
       for (const auto &g : ghost_numbers)
         field.ghost_nodes.emplace_back(g.first,
                                        partitioner.global_to_local(std::uint64_t(g.second) * field.n_comp));
       // Owned nodes that other ranks also reach: their sums arrive through compress().
-      field.import_nodes.clear();
       for (const auto &range : partitioner.import_indices())
         for (unsigned int l = range.first; l < range.second; ++l)
           {
@@ -630,7 +636,7 @@ namespace hysteron
     void
     BackgroundGrid<dim>::exchange(const unsigned int first, const unsigned int n)
     {
-      if (n_ranks > 1)
+      if (n_ranks > 1 && n_global_nodes > 0)
         add_shared(main, nodes, first, n, 1, n_comp);
     }
 
@@ -640,7 +646,7 @@ namespace hysteron
     void
     BackgroundGrid<dim>::exchange_layer(const unsigned int first, const unsigned int n)
     {
-      if (n_ranks > 1)
+      if (n_ranks > 1 && n_global_nodes > 0)
         add_shared(layer, layer_nodes, first, n, layer_blocks, layer_block_size);
     }
 

@@ -43,11 +43,11 @@ namespace hysteron
      * or of a step is over the whole lattice.
      *
      * Nodes shared by several ranks are added up through a
-     * LinearAlgebra::distributed::Vector: each lattice node is owned by the
-     * owner of its block (the block that holds the cell above it, the last one
-     * at the upper faces), the owned nodes are numbered rank by rank, and the
-     * ranks that reach a node hold it as a ghost (exchange()). On one rank
-     * nothing is communicated.
+     * LinearAlgebra::distributed::Vector over the shared nodes only: each
+     * lattice node is owned by the owner of its block (the block that holds the
+     * cell above it, the last one at the upper faces), the owned nodes that
+     * other ranks reach are numbered rank by rank, and those ranks hold them as
+     * ghosts (exchange()). On one rank nothing is communicated.
      */
     template <int dim>
     class BackgroundGrid
@@ -376,7 +376,7 @@ namespace hysteron
     private:
       /**
        * The exchange of one nodal array (n_comp doubles per node): a distributed
-       * vector over the owned nodes with the other reached nodes as ghosts, and
+       * vector over the shared nodes (owned, or reached as ghosts), and
        * (local box node, local vector index of component 0) of the ghosts and of
        * the owned nodes that other ranks reach.
        */
@@ -450,7 +450,8 @@ namespace hysteron
                        const std::array<unsigned int, dim> &n_cells,
                        const unsigned int                    margin);
 
-      /// The owned nodes' global numbers and the ghosts' (asked from their owners).
+      /// The shared nodes' numbers in the exchange: the owners number the nodes the
+      /// other ranks ask for.
       void
       number_nodes();
 
@@ -488,8 +489,9 @@ namespace hysteron
       std::vector<unsigned char>    owned_node;
       std::vector<double>           nodes;
 
-      /// Several ranks: the global number of each owned node (box order) and of each
-      /// ghost node (the reached nodes this rank does not own), by box node.
+      /// Several ranks: the numbers in the exchange of the owned nodes that other ranks
+      /// reach (box order) and of the ghost nodes (the reached nodes this rank does not
+      /// own), by box node.
       std::vector<std::pair<unsigned int, unsigned int>> owned_numbers, ghost_numbers;
       std::uint64_t                                      n_global_nodes = 0;
       unsigned int                                       first_owned_number = 0;
