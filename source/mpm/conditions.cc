@@ -5,6 +5,7 @@
 #include "mpm/mpm.h"
 
 #include <algorithm>
+#include <array>
 #include <iostream>
 #include <sstream>
 
@@ -26,28 +27,26 @@ namespace hysteron
           b.name       = description.name;
           b.type       = static_cast<unsigned int>(description.type);
           b.components = description.components;
-          for (unsigned int n = 0; n < grid->n_local_nodes(); ++n)
+          // (node, normal direction, normal sign) in the order of the box's nodes.
+          std::vector<std::array<int, 3>> selected;
+          grid->for_each_relevant_node([&](const unsigned int n) {
+            const auto i = grid->lattice_index(n);
+            for (const unsigned int face : description.faces)
+              {
+                const unsigned int d = face / 2;
+                if (i[d] == (face % 2 == 0 ? 0 : static_cast<int>(lattice.n_cells[d])))
+                  selected.push_back({{int(n), int(d), face % 2 == 0 ? 1 : -1}});
+              }
+            if (description.has_region &&
+                description.region.contains(grid->node_position(n), 1e-9 * cell_size))
+              selected.push_back({{int(n), 0, 0}});
+          });
+          std::stable_sort(selected.begin(), selected.end(), [](const auto &a, const auto &b) { return a[0] < b[0]; });
+          for (const auto &[n, d, sign] : selected)
             {
-              if (!grid->is_relevant(n))
-                continue;
-              const auto i = grid->lattice_index(n);
-              for (const unsigned int face : description.faces)
-                {
-                  const unsigned int d = face / 2;
-                  if (i[d] == (face % 2 == 0 ? 0 : static_cast<int>(lattice.n_cells[d])))
-                    {
-                      b.nodes.push_back(n);
-                      b.normal_direction.push_back(d);
-                      b.normal_sign.push_back(face % 2 == 0 ? 1 : -1);
-                    }
-                }
-              if (description.has_region &&
-                  description.region.contains(grid->node_position(n), 1e-9 * cell_size))
-                {
-                  b.nodes.push_back(n);
-                  b.normal_direction.push_back(0);
-                  b.normal_sign.push_back(0);
-                }
+              b.nodes.push_back(n);
+              b.normal_direction.push_back(d);
+              b.normal_sign.push_back(sign);
             }
           const unsigned long n_nodes = dealii::Utilities::MPI::sum<unsigned long>(
             std::count_if(b.nodes.begin(), b.nodes.end(), [&](const unsigned int n) { return grid->is_owned(n); }),

@@ -95,7 +95,7 @@ namespace hysteron
     Solver<dim>::setup_contact()
     {
       grid->initialize_layer(n_contact_blocks, contact_block);
-      contact_boundary_node.assign(grid->n_local_nodes(), 0);
+      contact_boundary_node.reset(grid->n_local_nodes(), grid->sparse_box());
       for (const auto &b : boundaries)
         for (const unsigned int n : b.nodes)
           contact_boundary_node[n] = 1;

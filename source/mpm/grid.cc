@@ -339,6 +339,23 @@ namespace hysteron
 
 
     template <int dim>
+    std::array<std::pair<int, int>, dim>
+    BackgroundGrid<dim>::node_range(const std::array<unsigned int, dim> &b) const
+    {
+      // A block's cells' nodes and `margin` layers around them, within the lattice.
+      std::array<std::pair<int, int>, dim> range;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          const int n = grid_lattice.n_cells[d];
+          range[d]    = {std::max<int>(0, int(b[d] * block_size()) - int(margin)),
+                         std::min<int>(n, std::min<int>(n, (b[d] + 1) * block_size()) + int(margin))};
+        }
+      return range;
+    }
+
+
+
+    template <int dim>
     void
     BackgroundGrid<dim>::setup_nodes(const unsigned int n_components)
     {
@@ -348,19 +365,15 @@ namespace hysteron
       std::array<int, dim> low, high;
       low.fill(INT_MAX);
       high.fill(INT_MIN);
-      const auto node_range = [&](const std::array<unsigned int, dim> &b, const unsigned int d) {
-        const int n  = grid_lattice.n_cells[d];
-        const int lo = std::max<int>(0, int(b[d] * block_size()) - int(margin));
-        const int hi = std::min<int>(n, std::min<int>(n, (b[d] + 1) * block_size()) + int(margin));
-        return std::make_pair(lo, hi);
-      };
       for (const auto &b : owned_block_list)
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            const auto [lo, hi] = node_range(b, d);
-            low[d]              = std::min(low[d], lo);
-            high[d]             = std::max(high[d], hi);
-          }
+        {
+          const auto range = node_range(b);
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              low[d]  = std::min(low[d], range[d].first);
+              high[d] = std::max(high[d], range[d].second);
+            }
+        }
       n_box_nodes = 1;
       for (unsigned int d = 0; d < dim; ++d)
         {
@@ -371,38 +384,42 @@ namespace hysteron
           box_stride[d] = n_box_nodes;
           n_box_nodes *= box_size[d];
         }
-      relevant_node.assign(n_box_nodes, 0);
-      owned_node.assign(n_box_nodes, 0);
+      // The box's arrays take memory only where the nodes this rank reaches lie; the
+      // flags are bits (a row of the box in a few bytes).
+      relevant_node.reset((n_box_nodes + 63) / 64);
+      owned_node.reset((n_box_nodes + 63) / 64);
+      // Reached: a block's range; owned: the nodes whose cell above lies in the block (the
+      // last block also owns the lattice's upper faces). Bits set block by block, row by row.
+      const auto mark = [&](ZeroPages<std::uint64_t> &bits, const std::array<std::pair<int, int>, dim> &range) {
+        std::array<int, dim> i;
+        for (unsigned int d = 0; d < dim; ++d)
+          i[d] = range[d].first;
+        while (true)
+          {
+            for (i[0] = range[0].first; i[0] <= range[0].second; ++i[0])
+              set_bit(bits, local_node(i));
+            unsigned int d = 1;
+            for (; d < dim; ++d)
+              if (++i[d] <= range[d].second)
+                break;
+              else
+                i[d] = range[d].first;
+            if (d >= dim)
+              break;
+          }
+      };
       for (const auto &b : owned_block_list)
         {
-          std::array<std::pair<int, int>, dim> range;
+          mark(relevant_node, node_range(b));
+          std::array<std::pair<int, int>, dim> own;
           for (unsigned int d = 0; d < dim; ++d)
-            range[d] = node_range(b, d);
-          std::array<int, dim> i;
-          for (unsigned int d = 0; d < dim; ++d)
-            i[d] = range[d].first;
-          while (true)
-            {
-              const unsigned int n = local_node(i);
-              relevant_node[n]     = 1;
-              // The owner of a node: the block of the cell above it (the last block at
-              // the upper faces).
-              bool mine = true;
-              for (unsigned int d = 0; d < dim; ++d)
-                mine = mine && std::min<unsigned int>(i[d] / block_size(), n_blocks[d] - 1) == b[d];
-              if (mine)
-                owned_node[n] = 1;
-              unsigned int d = 0;
-              for (; d < dim; ++d)
-                if (++i[d] <= range[d].second)
-                  break;
-                else
-                  i[d] = range[d].first;
-              if (d == dim)
-                break;
-            }
+            own[d] = {int(b[d] * block_size()),
+                      b[d] + 1 == n_blocks[d] ? int(grid_lattice.n_cells[d]) : int((b[d] + 1) * block_size()) - 1};
+          mark(owned_node, own);
         }
-      nodes.assign(std::size_t(n_box_nodes) * n_comp, 0.0);
+      n_relevant = 0;
+      for_each_relevant_node([&](const unsigned int) { ++n_relevant; });
+      nodes.reset(std::size_t(n_box_nodes) * n_comp, sparse_box());
       if (n_ranks > 1)
         {
           number_nodes();
@@ -441,13 +458,16 @@ namespace hysteron
       };
       std::map<unsigned int, std::vector<unsigned int>> asked;
       std::vector<unsigned int>                         ghost_box_nodes;
-      for (unsigned int n = 0; n < n_box_nodes; ++n)
-        if (relevant_node[n] && !owned_node[n])
-          {
-            const auto i = lattice_index(n);
-            asked[owner_of(i)].push_back(lattice_node(i));
-            ghost_box_nodes.push_back(n);
-          }
+      for_each_relevant_node([&](const unsigned int n) {
+        if (!is_owned(n))
+          ghost_box_nodes.push_back(n);
+      });
+      std::sort(ghost_box_nodes.begin(), ghost_box_nodes.end());
+      for (const unsigned int n : ghost_box_nodes)
+        {
+          const auto i = lattice_index(n);
+          asked[owner_of(i)].push_back(lattice_node(i));
+        }
       const auto answers = Utilities::MPI::some_to_some(comm, asked);
       const auto box_node_of = [&](const unsigned int node) {
         const auto           u = grid_lattice.node_index(node);
@@ -455,7 +475,7 @@ namespace hysteron
         for (unsigned int d = 0; d < dim; ++d)
           i[d] = u[d];
         const unsigned int n = local_node(i);
-        AssertThrow(owned_node[n], ExcMessage("mpm grid: a node asked for is not owned here"));
+        AssertThrow(is_owned(n), ExcMessage("mpm grid: a node asked for is not owned here"));
         return n;
       };
       std::vector<unsigned int> shared;
@@ -551,7 +571,7 @@ namespace hysteron
       layer.n_comp     = n_blocks_per_node * size_of_block;
       if (n_ranks > 1)
         connect(layer);
-      layer_nodes.assign(std::size_t(n_box_nodes) * layer.n_comp, 0.0);
+      layer_nodes.reset(std::size_t(n_box_nodes) * layer.n_comp, sparse_box());
     }
 
 
@@ -600,7 +620,7 @@ namespace hysteron
     template <int dim>
     void
     BackgroundGrid<dim>::add_shared(Field             &field,
-                                    std::vector<double> &values,
+                                    ZeroPages<double> &values,
                                     const unsigned int   first,
                                     const unsigned int   n,
                                     const unsigned int   n_blocks_per_node,
@@ -611,23 +631,27 @@ namespace hysteron
       // compress() adds the ghosts into their owners, update_ghost_values()
       // returns the sums. Components first + b * block_size + [0, n) of every
       // block b are exchanged.
+      // Owned shared nodes get their sums whether this rank reaches them or not (their
+      // reactions are counted here); the other ranks' nodes only where a point of this
+      // rank reaches them.
       const unsigned int stride = field.n_comp;
-      const auto         copy   = [&](const auto &list, const bool to_buffer) {
+      const auto         copy   = [&](const auto &list, const bool to_buffer, const bool reached_only) {
         for (const auto &[box, l] : list)
-          for (unsigned int b = 0; b < n_blocks_per_node; ++b)
-            for (unsigned int c = first + b * size_of_block; c < first + b * size_of_block + n; ++c)
-              if (to_buffer)
-                field.buffer.local_element(l + c) = values[std::size_t(box) * stride + c];
-              else
-                values[std::size_t(box) * stride + c] = field.buffer.local_element(l + c);
+          if (!reached_only || reached_stamps == nullptr || reached_stamps[box] == *current_stamp)
+            for (unsigned int b = 0; b < n_blocks_per_node; ++b)
+              for (unsigned int c = first + b * size_of_block; c < first + b * size_of_block + n; ++c)
+                if (to_buffer)
+                  field.buffer.local_element(l + c) = values[std::size_t(box) * stride + c];
+                else if (double &v = values[std::size_t(box) * stride + c]; v != field.buffer.local_element(l + c))
+                  v = field.buffer.local_element(l + c); // a zero stays unwritten: no page
       };
       field.buffer.zero_out_ghost_values();
-      copy(field.ghost_nodes, true);
-      copy(field.import_nodes, true);
+      copy(field.ghost_nodes, true, true);
+      copy(field.import_nodes, true, false);
       field.buffer.compress(dealii::VectorOperation::add);
       field.buffer.update_ghost_values();
-      copy(field.import_nodes, false);
-      copy(field.ghost_nodes, false);
+      copy(field.import_nodes, false, false);
+      copy(field.ghost_nodes, false, true);
     }
 
 
@@ -656,10 +680,11 @@ namespace hysteron
     void
     BackgroundGrid<dim>::zero_interface(const unsigned int first, const unsigned int n)
     {
-      for (const auto *list : {&main.ghost_nodes, &main.import_nodes})
-        for (const auto &entry : *list)
-          for (unsigned int c = first; c < first + n; ++c)
-            nodes[std::size_t(entry.first) * n_comp + c] = 0.0;
+      // Only what is not zero: a page never written stays unmapped.
+      for (const auto &entry : main.import_nodes)
+        for (unsigned int c = first; c < first + n; ++c)
+          if (double &v = nodes[std::size_t(entry.first) * n_comp + c]; v != 0.0)
+            v = 0.0;
     }
 
 
@@ -668,11 +693,11 @@ namespace hysteron
     void
     BackgroundGrid<dim>::zero_layer_interface(const unsigned int first, const unsigned int n)
     {
-      for (const auto *list : {&layer.ghost_nodes, &layer.import_nodes})
-        for (const auto &entry : *list)
-          for (unsigned int b = 0; b < layer_blocks; ++b)
-            for (unsigned int c = first + b * layer_block_size; c < first + b * layer_block_size + n; ++c)
-              layer_nodes[std::size_t(entry.first) * layer.n_comp + c] = 0.0;
+      for (const auto &entry : layer.import_nodes)
+        for (unsigned int b = 0; b < layer_blocks; ++b)
+          for (unsigned int c = first + b * layer_block_size; c < first + b * layer_block_size + n; ++c)
+            if (double &v = layer_nodes[std::size_t(entry.first) * layer.n_comp + c]; v != 0.0)
+              v = 0.0;
     }
 
 
@@ -681,9 +706,10 @@ namespace hysteron
     std::size_t
     BackgroundGrid<dim>::memory_consumption() const
     {
-      std::size_t bytes = (nodes.capacity() + layer_nodes.capacity()) * sizeof(double) +
-                          relevant_node.capacity() + owned_node.capacity() + block_state.capacity() +
-                          block_owner.capacity() * sizeof(unsigned int) +
+      // The box's arrays hold pages where the reached nodes lie: count those nodes.
+      std::size_t bytes = n_relevant * n_comp * sizeof(double) + n_box_nodes / 4 +
+                          (layer_nodes.size() > 0 ? n_relevant * layer.n_comp * sizeof(double) : 0) +
+                          block_state.capacity() + block_owner.capacity() * sizeof(unsigned int) +
                           block_cell.capacity() * sizeof(std::pair<int, int>) +
                           (owned_numbers.capacity() + ghost_numbers.capacity()) *
                             sizeof(std::pair<unsigned int, unsigned int>);

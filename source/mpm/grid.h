@@ -9,6 +9,7 @@
 #include <boost/range/iterator_range.hpp>
 
 #include "mpm/basis.h"
+#include "mpm/zero_pages.h"
 
 #include <array>
 #include <cstdint>
@@ -309,27 +310,57 @@ namespace hysteron
       bool
       is_relevant(const unsigned int n) const
       {
-        return relevant_node[n] != 0;
+        return bit(relevant_node, n);
       }
 
       /// Is local node @p n owned by this rank (reactions and sums count owned nodes once)?
       bool
       is_owned(const unsigned int n) const
       {
-        return owned_node[n] != 0;
+        return bit(owned_node, n);
       }
 
       /// The nodal data: n_local_nodes() * n_components() doubles.
-      std::vector<double> &
+      ZeroPages<double> &
       data()
       {
         return nodes;
       }
 
       /**
+       * Call @p f(n) for every local node a point of this rank can reach
+       * (is_relevant()), in box order.
+       */
+      template <typename Function>
+      void
+      for_each_relevant_node(const Function &f) const;
+
+      /// Whether the box holds many more nodes than this rank reaches (its arrays per
+      /// node should then be sparse ZeroPages).
+      bool
+      sparse_box() const
+      {
+        return 2 * n_relevant < n_box_nodes;
+      }
+
+      /**
+       * The nodes this rank reaches in the current step are those with
+       * stamps[n] == *stamp (the kernels' marks): exchange() writes the sums at
+       * the shared nodes that other ranks own only into these (a node this rank
+       * does not reach is not read here, and writing it would take a page of
+       * memory).
+       */
+      void
+      track_reached_nodes(const unsigned int *stamps, const unsigned int *stamp)
+      {
+        reached_stamps  = stamps;
+        current_stamp   = stamp;
+      }
+
+      /**
        * Add up the components [first, first + n) of the nodes shared with other
-       * ranks, so that every rank holds the global sums at all its relevant
-       * nodes. A no-op on one rank.
+       * ranks, so that every rank holds the global sums at its owned nodes and at
+       * the nodes it reaches in this step. A no-op on one rank.
        */
       void
       exchange(const unsigned int first, const unsigned int n);
@@ -343,7 +374,7 @@ namespace hysteron
       initialize_layer(const unsigned int n_blocks, const unsigned int block_size);
 
       /// The layer's data: n_local_nodes() * n_blocks * block_size doubles.
-      std::vector<double> &
+      ZeroPages<double> &
       layer_data()
       {
         return layer_nodes;
@@ -357,9 +388,8 @@ namespace hysteron
       void
       zero_layer_interface(const unsigned int first, const unsigned int n);
 
-      /// Set the components [first, first + n) of the interface nodes to zero
-      /// (the nodes whose values exchange() may have changed without this rank
-      /// touching them).
+      /// Set the components [first, first + n) of the owned shared nodes to zero
+      /// (exchange() writes their sums whether this rank reaches them or not).
       void
       zero_interface(const unsigned int first, const unsigned int n);
 
@@ -394,8 +424,8 @@ namespace hysteron
 
       /// Add up the blocks' components [first, first + n) of @p values at the shared nodes.
       void
-      add_shared(Field               &field,
-                 std::vector<double> &values,
+      add_shared(Field             &field,
+                 ZeroPages<double> &values,
                  const unsigned int   first,
                  const unsigned int   n,
                  const unsigned int   n_blocks,
@@ -485,9 +515,27 @@ namespace hysteron
       std::array<unsigned int, dim> box_size;
       std::array<unsigned int, dim> box_stride;
       unsigned int                  n_box_nodes = 0;
-      std::vector<unsigned char>    relevant_node;
-      std::vector<unsigned char>    owned_node;
-      std::vector<double>           nodes;
+      /// Per box node, one bit each: reached by this rank's points; owned.
+      ZeroPages<std::uint64_t>      relevant_node;
+      ZeroPages<std::uint64_t>      owned_node;
+      std::size_t                   n_relevant = 0;
+      ZeroPages<double>             nodes;
+
+      static bool
+      bit(const ZeroPages<std::uint64_t> &bits, const unsigned int n)
+      {
+        return (bits[n >> 6] >> (n & 63)) & 1;
+      }
+
+      static void
+      set_bit(ZeroPages<std::uint64_t> &bits, const unsigned int n)
+      {
+        bits[n >> 6] |= std::uint64_t(1) << (n & 63);
+      }
+
+      /// The nodes block @p b's points reach, per direction: [first, last] lattice indices.
+      std::array<std::pair<int, int>, dim>
+      node_range(const std::array<unsigned int, dim> &b) const;
 
       /// Several ranks: the numbers in the exchange of the owned nodes that other ranks
       /// reach (box order) and of the ghost nodes (the reached nodes this rank does not
@@ -497,11 +545,30 @@ namespace hysteron
       unsigned int                                       first_owned_number = 0;
       Field                                              main;
 
+      /// The marks of the nodes reached in the current step (track_reached_nodes()).
+      const unsigned int *reached_stamps = nullptr;
+      const unsigned int *current_stamp  = nullptr;
+
       /// The optional second array (initialize_layer()).
-      std::vector<double> layer_nodes;
+      ZeroPages<double>   layer_nodes;
       Field               layer;
       unsigned int        layer_blocks = 0, layer_block_size = 0;
     };
+
+
+
+    template <int dim>
+    template <typename Function>
+    void
+    BackgroundGrid<dim>::for_each_relevant_node(const Function &f) const
+    {
+      // The set bits in box order: a word without one costs a compare (and a page of
+      // the box that no node of this rank lies in is the kernel's zero page).
+      const std::size_t n_words = (std::size_t(n_box_nodes) + 63) / 64;
+      for (std::size_t w = 0; w < n_words; ++w)
+        for (std::uint64_t word = relevant_node[w]; word != 0; word &= word - 1)
+          f(static_cast<unsigned int>(64 * w + __builtin_ctzll(word)));
+    }
   } // namespace MPM
 } // namespace hysteron
 

@@ -73,14 +73,14 @@ namespace hysteron
                             Patterns::Double(),
                             "Edge length h of the square (cubic) grid cells [m], > 0.");
           prm.declare_entry("Cell weight",
-                            "0.1",
+                            "0.01",
                             Patterns::Double(),
                             "The work of one grid cell, counted in material points [-], >= 0, "
                             "when the grid is split between MPI ranks: each rank gets an equal "
-                            "share of (material points + Cell weight x grid cells). 0 balances "
-                            "the points alone (the time of a step: a cell without points costs "
-                            "nothing in a step); larger values also balance the grid's memory "
-                            "and set-up (a grid mostly empty of points).");
+                            "share of (material points + Cell weight x grid cells). A cell without "
+                            "points costs nothing in a step and little memory (a few bytes per "
+                            "node), a point about 1 kB and the work of a step: the default "
+                            "balances the points, and splits a grid's empty regions too.");
           declare_grid_motion_parameters(prm);
         }
         prm.leave_subsection();

@@ -163,7 +163,7 @@ namespace hysteron
       std::vector<Geometry::Region<dim>> average_regions;
       double                        small_mass = 0; ///< nodes lighter than this have no velocity
       /// The work of a grid cell, in material points, when p4est balances the ranks.
-      double                        cell_weight = 0.1;
+      double                        cell_weight = 0.01;
 
       // The moving grid (`MPM/Grid/Motion`, grid_motion.cc). The lattice is moved
       // after every step; the kernels see only the lattice of their step.
@@ -326,7 +326,7 @@ namespace hysteron
       /// Whether the layer holds the momenta of particles_to_grid() (not yet converted).
       bool                          layer_from_points = true;
       /// Per local node: is it a node of a boundary condition (contact only).
-      std::vector<unsigned char>    contact_boundary_node;
+      ZeroPages<unsigned char>      contact_boundary_node;
       /// Scratch of apply_contact(): per body, the trial and the rigid velocities.
       std::vector<dealii::Tensor<1, dim>> contact_velocity, contact_rigid_velocity;
       /// Allocate the layer and the scratch of contact (after setup_boundaries()).
@@ -384,8 +384,8 @@ namespace hysteron
 
       // Nodes touched this step (their stamp is the step number).
       std::vector<unsigned int> active_nodes;
-      std::vector<unsigned int> node_stamp;
-      std::vector<unsigned int> rigid_node_body; ///< 1 + rigid body index at a node, 0 none
+      ZeroPages<unsigned int>   node_stamp;
+      ZeroPages<unsigned int>   rigid_node_body; ///< 1 + rigid body index at a node, 0 none
       std::vector<unsigned int> rigid_nodes;
       unsigned int              stamp = 0;
 

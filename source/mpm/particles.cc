@@ -138,8 +138,9 @@ namespace hysteron
                       " material points lie inside that body's shape (two bodies in one place would "
                       "double the mass there)");
           }
-      node_stamp.assign(grid->n_local_nodes(), 0);
-      rigid_node_body.assign(grid->n_local_nodes(), 0);
+      node_stamp.reset(grid->n_local_nodes(), grid->sparse_box());
+      rigid_node_body.reset(grid->n_local_nodes(), grid->sparse_box());
+      grid->track_reached_nodes(node_stamp.data(), &stamp);
       active_nodes.clear();
       rigid_nodes.clear();
     }
