@@ -118,7 +118,9 @@ namespace hysteron
           {
             runtime = e.what();
           }
-        if (dealii::Utilities::MPI::n_mpi_processes(comm) == 1)
+        // One reduction when no rank failed; the messages only when one did.
+        const int failed = input_problem.empty() && runtime.empty() ? 0 : 1;
+        if (dealii::Utilities::MPI::n_mpi_processes(comm) == 1 || dealii::Utilities::MPI::max(failed, comm) == 0)
           {
             if (!input_problem.empty())
               throw InputError(input_where, input_problem);

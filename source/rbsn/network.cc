@@ -173,7 +173,8 @@ namespace hysteron
         nuclei.hold_all(sample_one_block(fixed));
       else
         sample_blocks(fixed, layout, nuclei);
-      n_cells = nuclei.size();
+      n_cells  = nuclei.size();
+      n_blocks = layout.single() ? 1 : layout.size();
       require(n_cells >= 2,
               "RBSN/Minimum distance",
               "leaves room for " + std::to_string(n_cells) +

@@ -1,4 +1,5 @@
 #include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
 #include <deal.II/lac/full_matrix.h>
 
 #include <hysteron/rbsn/model.h>
@@ -671,12 +672,27 @@ namespace hysteron
       update_fragments();
       locate_probes();
       stage("supports, loads and probes");
+      if (stage.enabled())
+        {
+          // The set-up's peak resident memory of the ranks (VmHWM), the least and the most.
+          dealii::Utilities::System::MemoryStats memory;
+          dealii::Utilities::System::get_memory_stats(memory);
+          const MPI_Comm     comm = scene.mpi_communicator();
+          const double       mb   = memory.VmHWM / 1024.0;
+          std::ostringstream line;
+          line << std::fixed << std::setprecision(0) << "rbsn: set-up peak memory per rank "
+               << dealii::Utilities::MPI::min(mb, comm) << " ... " << dealii::Utilities::MPI::max(mb, comm) << " MB";
+          scene.console() << line.str() << std::endl;
+        }
       scene.console() << "rbsn: " << n_cells << " cells, " << n_global_facets << " facets (";
       if (spacing.is_constant())
         scene.console() << "d_m = " << d_m;
       else
         scene.console() << "d = " << spacing.min << " ... " << spacing.max;
-      scene.console() << " m), " << n_dofs * n_cells << " DoFs" << std::endl;
+      scene.console() << " m";
+      if (n_blocks > 1)
+        scene.console() << ", sampled in " << n_blocks << " blocks";
+      scene.console() << "), " << n_dofs * n_cells << " DoFs" << std::endl;
       if ((analysis == Analysis::quasi_static || analysis == Analysis::implicit_dynamics) &&
           !consistent_tangent && scene.is_root())
         std::cerr << "hysteron: warning: RBSN: the springs' tangent is not the algorithmic one "

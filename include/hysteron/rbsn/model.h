@@ -499,6 +499,7 @@ namespace hysteron
 
       // The whole network: its numbers of cells and facets, the box of its nuclei.
       std::uint64_t                   n_cells         = 0;
+      unsigned int                    n_blocks        = 1; ///< of the sampling (blocks.cc)
       unsigned long                   n_global_facets = 0;
       std::vector<dealii::Point<dim>> nuclei_box; ///< the lower and upper corner of the nuclei
 
