@@ -133,7 +133,8 @@ namespace hysteron
                           "UMFPACK",
                           Patterns::Selection("UMFPACK|Amesos_Klu|Amesos_Mumps"),
                           "Under mpirun (more than one rank) the cells are split over the ranks "
-                          "(coordinate bisection), each rank builds and assembles its cells and "
+                          "(shares along the sampling blocks, coordinate bisection within a block), "
+                          "each rank builds and assembles its cells and "
                           "facets, and the distributed tangent "
                           "goes to: UMFPACK (the default: gathered on rank 0 and factorized there "
                           "with the symbolic analysis kept, as on one rank; reproducible bit for "
