@@ -159,6 +159,8 @@ def setup_run(build, directory, text, ranks):
                     result[column] = float(m.group(2))
             if "nuclei" in m.group(1):
                 result["cells"] = int(m.group(1).split()[0].replace(",", ""))
+                blocks = re.search(r"in (\d+) blocks", m.group(1))
+                result["blocks"] = int(blocks.group(1)) if blocks else 1
             if "supports" in m.group(1) and not has_memory_line(build):
                 # A build without the memory line: the ranks' VmHWM now.
                 pids = descendants(p.pid)
@@ -198,15 +200,15 @@ def table(title, rows, extra=""):
     print(f"\n### {title}\n")
     if extra:
         print(extra + "\n")
-    print("| build | ranks | cells | cells per rank | nuclei [s] | Voronoi [s] | springs [s] | pattern [s] | "
+    print("| build | ranks | cells | blocks | cells per rank | nuclei [s] | Voronoi [s] | springs [s] | pattern [s] | "
           "rest [s] | set-up [s] | CPU per rank [s] | peak memory per rank [MB] | vs 1 rank |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     base = {}
     for r in rows:
         key = r["build"]
         if r["ranks"] == min(x["ranks"] for x in rows if x["build"] == key):
             base[key] = r["rss_max"]
-        print(f"| {r['build']} | {r['ranks']} | {r['cells']:,} | {r['cells'] // r['ranks']:,} | {r['nuclei']:.1f} | "
+        print(f"| {r['build']} | {r['ranks']} | {r['cells']:,} | {r['blocks']} | {r['cells'] // r['ranks']:,} | {r['nuclei']:.1f} | "
               f"{r['cells_s']:.1f} | {r['springs']:.1f} | {r['pattern']:.1f} | {r['rest']:.1f} | {r['setup']:.1f} | "
               f"{r['cpu']:.1f} | "
               f"{r['rss_min']:.0f} ... {r['rss_max']:.0f} | {100 * (r['rss_max'] / base[key] - 1):+.1f} % |")
@@ -268,7 +270,7 @@ def main():
     print(f"\nLoad average at the end: {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}")
     if args.csv:
         with open(args.csv, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=["series", "build", "ranks", "cells", "nuclei", "cells_s", "springs",
+            w = csv.DictWriter(f, fieldnames=["series", "build", "ranks", "cells", "blocks", "nuclei", "cells_s", "springs",
                                               "pattern", "rest", "setup", "cpu", "rss_min", "rss_max", "rss_source", "wall"])
             w.writeheader()
             for r in rows:
