@@ -16,6 +16,8 @@ The scene runs in a fresh working directory (relative output paths land there) w
   # EXPECT-STDERR: <regex>        stderr must match (e.g. a warning) on a successful run
   # EXPECT-STDOUT: <regex>        stdout must match on a successful run
   # ARGS: <arguments>             command line instead of "--quiet <prm>" ({prm} = the file)
+  # RANKS: <n>                    run the scene on n MPI ranks (e.g. an error only several
+                                  ranks give); MPI lines add runs on their ranks as before
   # FILES: <path>[, <path>]       input files the scene reads (paths relative to the .prm),
                                   copied into the working directory with the .prm
   # MPI: 2                        also run on 2 ranks; every output file must be identical
@@ -50,7 +52,7 @@ SAFE = {
 def parse_directives(path):
     directives = []
     pattern = re.compile(r"^\s*#\s*(CHECK-LAST|CHECK-COLUMNS|CHECK|EXPECT-ERROR|EXPECT-STDERR|EXPECT-STDOUT|EXIT|"
-                         r"ARGS|FILES|MPI-TOLERANCE|MPI-IGNORE|MPI)\b\s*([^:]*):\s?(.*)$")
+                         r"ARGS|FILES|RANKS|MPI-TOLERANCE|MPI-IGNORE|MPI)\b\s*([^:]*):\s?(.*)$")
     with open(path) as f:
         for line in f:
             m = pattern.match(line)
@@ -131,10 +133,12 @@ def main():
     arg_line = next((v for k, _, v in directives if k == "ARGS"), "--quiet {prm}")
     command = [args.hysteron] + [a.replace("{prm}", os.path.basename(prm))
                                  for a in arg_line.split()]
+    ranks_line = next((v for k, _, v in directives if k == "RANKS"), None)
+    main_command = ([args.mpiexec, "-np", ranks_line.strip()] + command) if ranks_line else command
     failures = []
 
-    code, out, err = run(command, args.workdir, env)
-    print("$ " + " ".join(command))
+    code, out, err = run(main_command, args.workdir, env)
+    print("$ " + " ".join(main_command))
     if out:
         print(out[-4000:])
     if err:

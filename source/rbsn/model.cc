@@ -40,6 +40,17 @@ namespace hysteron
                           "q, about 0.68 int 1/d^2 dA points (0.70 int 1/d^3 dV in 3D); d must be "
                           "finite and > 0 in the bodies and "
                           "should vary slowly (|grad d| well below 1; doc/rbsn.md).");
+        prm.declare_entry("Sampling block size",
+                          "0",
+                          Patterns::Double(),
+                          "Side [m] of the blocks in which the random nuclei are sampled, >= 0; "
+                          "0: automatic, one block for a network of at most 20,000 predicted points "
+                          "(10,000 in 3D), else blocks of about 4,096 points (2,048 in 3D). A "
+                          "network of several blocks is sampled block by block, in parallel on the "
+                          "MPI ranks, each rank holding only the nuclei near its cells, and is the "
+                          "same on any number of ranks; a given size must be at least 2 d_max "
+                          "(doc/rbsn.md, MPI). One block (a size above the bodies' box) samples "
+                          "the whole network at once, on every rank.");
         prm.declare_entry("Points on the boundary",
                           "true",
                           Patterns::Bool(),
@@ -122,7 +133,8 @@ namespace hysteron
                           "UMFPACK",
                           Patterns::Selection("UMFPACK|Amesos_Klu|Amesos_Mumps"),
                           "Under mpirun (more than one rank) the cells are split over the ranks "
-                          "(coordinate bisection), each rank builds and assembles its cells and "
+                          "(shares along the sampling blocks, coordinate bisection within a block), "
+                          "each rank builds and assembles its cells and "
                           "facets, and the distributed tangent "
                           "goes to: UMFPACK (the default: gathered on rank 0 and factorized there "
                           "with the symbolic analysis kept, as on one rank; reproducible bit for "
@@ -149,6 +161,11 @@ namespace hysteron
                           "1000",
                           Patterns::Integer(1),
                           "cg / gmres: iterations before the attempt fails (and the increment is cut).");
+        prm.declare_entry("Write cell table",
+                          "false",
+                          Patterns::Bool(),
+                          "Write cells.csv at the end: every cell (its number, nucleus, body, area "
+                          "or volume, displacement and rotation).");
         prm.declare_entry("Write spring table",
                           "false",
                           Patterns::Bool(),
@@ -218,6 +235,7 @@ namespace hysteron
                                    s.where("Minimum distance"));
           }
         points_on_boundary = s.get_bool("Points on the boundary");
+        block_size         = s.get_non_negative("Sampling block size");
         extra_points       = parse_points<dim>(s.get("Additional points"), s.where("Additional points"));
         boundary_h         = s.get_non_negative("Curved boundary resolution"); // 0: in build_network()
         shear_ratio  = s.get_non_negative("Shear stiffness ratio");
@@ -233,6 +251,7 @@ namespace hysteron
         time_step    = s.get_non_negative("Time step");
         n_increments = s.get_integer("Number of increments");
         spring_table = s.get_bool("Write spring table");
+        cell_table   = s.get_bool("Write cell table");
         reuse_tolerance = s.get_non_negative("Tangent reuse tolerance");
         incremental_assembly = s.get_bool("Incremental assembly");
         distributed_solver = s.get("Distributed direct solver");
@@ -368,8 +387,8 @@ namespace hysteron
           // facet's point P as a point of cell b minus as a point of cell a, u_P = u_i +
           // theta_i x (P - x_i), in the facet's axes, and the relative rotation
           // theta_b - theta_a in them.
-          const dealii::Tensor<1, dim> ra = f.midpoint - nuclei[cell_id[f.a]];
-          const dealii::Tensor<1, dim> rb = f.midpoint - nuclei[cell_id[f.b]];
+          const dealii::Tensor<1, dim> ra = f.midpoint - local_nuclei[f.a];
+          const dealii::Tensor<1, dim> rb = f.midpoint - local_nuclei[f.b];
           if constexpr (dim == 2)
             {
               // The thinner side at the facet's midpoint (two bodies may meet there).
@@ -465,7 +484,7 @@ namespace hysteron
       const bool gathered = distributed() && linear_solver == "direct" && distributed_solver == "UMFPACK";
       if (!trilinos_system() || (gathered && scene.is_root()))
         {
-          const dof_index                n = n_dofs * nuclei.size();
+          const dof_index                n = n_dofs * n_cells;
           dealii::DynamicSparsityPattern dsp(n, n);
           const auto block = [&](const dof_index p, const dof_index q) {
             for (unsigned int i = 0; i < n_dofs; ++i)
@@ -485,7 +504,7 @@ namespace hysteron
             {
               // Rank 0 holds the whole pattern: the cells' blocks and every rank's facets'
               // pairs of blocks (gathered once).
-              for (dof_index c = 0; c < nuclei.size(); ++c)
+              for (dof_index c = 0; c < n_cells; ++c)
                 block(c, c);
               std::vector<unsigned long long> pairs;
               for (const auto &f : network.facets)
@@ -523,7 +542,7 @@ namespace hysteron
       const double tolerance = 1e-9 * scale;
       const MPI_Comm comm    = network_communicator();
       const unsigned int n_local = cell_id.size();
-      const auto nucleus = [&](const unsigned int c) -> const dealii::Point<dim> & { return nuclei[cell_id[c]]; };
+      const auto nucleus = [&](const unsigned int c) -> const dealii::Point<dim> & { return local_nuclei[c]; };
       const auto count   = [&](const std::size_t n) { return dealii::Utilities::MPI::sum<unsigned long>(n, comm); };
       // History sets: the cells whose nucleus lies on the set's faces of the nuclei's box
       // or in its region (the rule of the boundary conditions).
@@ -707,7 +726,7 @@ namespace hysteron
       if (set.rigid >= 0)
         return k < dim ? scene.body_descriptions()[set.rigid].rigid_displacement(t0, t1)[k] : 0.0;
       const auto &d = scene.boundary_descriptions()[set.boundary];
-      const auto &x = nuclei[cell_id[c]];
+      const auto &x = local_nuclei[c];
       if (k < dim && (d.velocity || d.displacement))
         return d.displacement_increment(t0, t1, x)[k];
       if (k >= dim && d.displacement)
@@ -914,7 +933,7 @@ namespace hysteron
     Model<dim>::summary(const unsigned long steps, const unsigned int outputs) const
     {
       std::ostringstream s;
-      s << nuclei.size() << " cells, " << n_global_facets << " facets, "
+      s << n_cells << " cells, " << n_global_facets << " facets, "
         << (analysis == Analysis::variable_order ? n_steps : steps) << " steps, " << n_newton
         << " Newton iterations";
       s << ", " << n_factorizations << " factorizations";

@@ -1,22 +1,29 @@
-// The network: the nuclei (every rank), their partition over the ranks, and each
-// rank's own cells, ghost cells and facets with their mass properties.
+// The network: the nuclei (sampled block by block, blocks.cc), their split over the
+// ranks, and each rank's own cells, ghost cells and facets with their mass properties.
 //
-// Every rank samples the same nuclei from the same seed: they are the one thing it
-// holds for the whole network (2 or 3 doubles and a rank per cell). The nuclei are
-// split into parts of equal size by recursive coordinate bisection (each cut across
-// the longest side of the part's box), which needs no graph and gives compact parts.
-// A rank builds the Voronoi cells of its own nuclei from them and the nuclei within
-// a halo of width H around them. A cell's geometry depends only on the nuclei near
-// it: the clipped cell V_i lies within its reach rho_i of the nucleus, and a nucleus q
+// A network predicted to be small (at most 20,000 points in 2D, 10,000 in 3D, unless
+// `Sampling block size` is given) is one block: every rank samples all its nuclei, as
+// a single rank does. A larger one is tiled into blocks that the ranks sample in
+// parallel; a rank holds the nuclei of its blocks and of those around its cells only.
+// The cells are numbered block by block (a network of one block in the order of its
+// nuclei), so the numbers are the same on any number of ranks; each rank owns a
+// consecutive share of them along the blocks' Hilbert order, a block two ranks share
+// being split by coordinate bisection.
+//
+// A rank builds the Voronoi cells of its own nuclei from them and the nuclei within a
+// halo of width H around them. A cell's geometry depends only on the nuclei near it:
+// the clipped cell V_i lies within its reach rho_i of the nucleus, and a nucleus q
 // farther than 2 rho_i from it cannot cut it (for x in V_i, |x - q| >= |q - x_i| -
 // |x - x_i| > rho_i >= |x - x_i|). So the cells are exact when 2 rho_i <= H for each;
 // a saturated Poisson-disk set has rho <= d_max, and H starts at 2.5 d_max (and is
-// doubled for a cell that needs more).
+// doubled for a cell that needs more, the nuclei of the blocks farther out fetched).
 #include <deal.II/base/mpi.h>
 
 #include <hysteron/base/exceptions.h>
 #include <hysteron/rbsn/model.h>
 
+#include "rbsn/blocks.h"
+#include "rbsn/collective.h"
 #include "rbsn/polyhedron.h"
 
 #include <algorithm>
@@ -30,100 +37,87 @@ namespace hysteron
 {
   namespace RBSN
   {
-    namespace
+    template <int dim>
+    std::vector<dealii::Point<dim>>
+    Model<dim>::fixed_points() const
     {
-      /// The same error on every rank of @p comm if @p f throws on any (the first
-      /// rank's message): the ranks of a distributed set-up never diverge.
-      template <typename Function>
-      void
-      collectively(const MPI_Comm comm, Function f)
-      {
-        std::string input_where, input_problem, runtime;
-        try
+      // The user's points, then points along every body's boundary; points closer than
+      // 1e-6 d_m (corners shared by touching bodies) merged, the first kept: each point
+      // is compared with the kept ones in its and the neighbouring cells of a hash grid
+      // of that size.
+      std::vector<dealii::Point<dim>> fixed = extra_points;
+      for (const auto &p : extra_points)
+        {
+          bool inside = false;
+          for (const auto *shape : body_shapes)
+            inside = inside || shape->contains(p, 1e-9 * d_m);
+          std::ostringstream point;
+          point << p;
+          require(inside, "RBSN/Additional points", "the point (" + point.str() + ") lies in no deformable body");
+        }
+      if (points_on_boundary)
+        for (unsigned int s = 0; s < body_shapes.size(); ++s)
           {
-            f();
+            std::vector<dealii::Point<dim>> p;
+            if constexpr (dim == 2)
+              p = boundary_points(*body_shapes[s], spacing, boundary_h);
+            else
+              p = boundary_points(*body_shapes[s], spacing, boundary_h, scene.random_seed() + 104729 * s);
+            fixed.insert(fixed.end(), p.begin(), p.end());
           }
-        catch (const InputError &e)
-          {
-            input_where   = e.where();
-            input_problem = e.problem();
-          }
-        catch (const RuntimeError &e)
-          {
-            runtime = e.what();
-          }
-        if (dealii::Utilities::MPI::n_mpi_processes(comm) == 1)
-          {
-            if (!input_problem.empty())
-              throw InputError(input_where, input_problem);
-            if (!runtime.empty())
-              throw RuntimeError(runtime);
-            return;
-          }
-        const auto wheres   = dealii::Utilities::MPI::all_gather(comm, input_where);
-        const auto problems = dealii::Utilities::MPI::all_gather(comm, input_problem);
-        const auto runtimes = dealii::Utilities::MPI::all_gather(comm, runtime);
-        for (unsigned int r = 0; r < problems.size(); ++r)
-          {
-            if (!problems[r].empty())
-              throw InputError(wheres[r], problems[r]);
-            if (!runtimes[r].empty())
-              throw RuntimeError(runtimes[r]);
-          }
-      }
-    } // namespace
+      std::vector<dealii::Point<dim>> points;
+      const double                    tolerance = 1e-6 * d_m;
+      using Key                                 = std::array<long long, dim>;
+      std::map<Key, std::vector<unsigned int>> kept;
+      const auto key = [&](const dealii::Point<dim> &p, const std::array<int, dim> &shift) {
+        Key k;
+        for (unsigned int d = 0; d < dim; ++d)
+          k[d] = static_cast<long long>(std::floor(p[d] / tolerance)) + shift[d];
+        return k;
+      };
+      for (const auto &p : fixed)
+        {
+          bool seen = false;
+          // The 3^dim neighbouring keys, the last coordinate slowest.
+          for (unsigned int m = 0; m < (dim == 2 ? 9u : 27u) && !seen; ++m)
+            {
+              std::array<int, dim> shift;
+              unsigned int         r = m;
+              for (unsigned int d = 0; d < dim; ++d, r /= 3)
+                shift[d] = static_cast<int>(r % 3) - 1;
+              if (const auto k = kept.find(key(p, shift)); k != kept.end())
+                for (const unsigned int q : k->second)
+                  seen = seen || p.distance(points[q]) < tolerance;
+            }
+          if (!seen)
+            {
+              kept[key(p, std::array<int, dim>{})].push_back(points.size());
+              points.push_back(p);
+            }
+        }
+      return points;
+    }
 
 
 
     template <int dim>
-    std::vector<unsigned int>
-    Model<dim>::partition_nuclei(const unsigned int n) const
+    double
+    Model<dim>::sampling_block_side() const
     {
-      // Parts [first, first + count) of the ranks for the cells in ids: a cut across the
-      // longest side of their box, with as many cells on each side as parts (the lower
-      // coordinate, then the lower number, first: deterministic).
-      std::vector<unsigned int> result(nuclei.size(), 0);
-      std::vector<unsigned int> ids(nuclei.size());
-      std::iota(ids.begin(), ids.end(), 0u);
-      struct Range
-      {
-        std::size_t  begin, end;
-        unsigned int first, count;
-      };
-      std::vector<Range> todo{{0, ids.size(), 0, n}};
-      while (!todo.empty())
+      // A network predicted above the threshold is tiled into blocks of about 4,096
+      // points (2,048 in 3D), at least 4 d_max wide; one below it is one block.
+      if (block_size > 0)
         {
-          const Range r = todo.back();
-          todo.pop_back();
-          if (r.count == 1)
-            {
-              for (std::size_t k = r.begin; k < r.end; ++k)
-                result[ids[k]] = r.first;
-              continue;
-            }
-          dealii::Point<dim> lo = nuclei[ids[r.begin]], hi = lo;
-          for (std::size_t k = r.begin; k < r.end; ++k)
-            for (unsigned int d = 0; d < dim; ++d)
-              {
-                lo[d] = std::min(lo[d], nuclei[ids[k]][d]);
-                hi[d] = std::max(hi[d], nuclei[ids[k]][d]);
-              }
-          unsigned int axis = 0;
-          for (unsigned int d = 1; d < dim; ++d)
-            if (hi[d] - lo[d] > hi[axis] - lo[axis])
-              axis = d;
-          const unsigned int left_parts = r.count / 2;
-          const std::size_t  middle =
-            r.begin + static_cast<std::size_t>(std::llround(double(r.end - r.begin) * left_parts / r.count));
-          std::nth_element(ids.begin() + r.begin, ids.begin() + middle, ids.begin() + r.end,
-                           [&](const unsigned int a, const unsigned int b) {
-                             return nuclei[a][axis] < nuclei[b][axis] ||
-                                    (nuclei[a][axis] == nuclei[b][axis] && a < b);
-                           });
-          todo.push_back({r.begin, middle, r.first, left_parts});
-          todo.push_back({middle, r.end, r.first + left_parts, r.count - left_parts});
+          std::ostringstream s;
+          s << "must be at least 2 d_max = " << 2 * spacing.max
+            << " m (the margin of known points around a block; got " << block_size << " m)";
+          require(block_size >= 2 * spacing.max, "RBSN/Sampling block size", s.str());
+          return block_size;
         }
-      return result;
+      if (spacing.predicted_points <= single_block_points)
+        return 0;
+      const double per_block = dim == 2 ? 4096 : 2048;
+      return std::max(4 * spacing.max, std::pow(per_block * spacing.measure / spacing.predicted_points, 1.0 / dim));
     }
 
 
@@ -132,7 +126,6 @@ namespace hysteron
     void
     Model<dim>::build_network()
     {
-      const auto &bodies = scene.body_descriptions();
       // d over the bodies: its smallest value (d_m for the messages and the default
       // resolution of curved boundaries) and the predicted number of points,
       // 0.68 int 1/d^2 dA (0.70 int 1/d^3 dV in 3D), which guards the memory and
@@ -157,67 +150,67 @@ namespace hysteron
         scene.console() << "rbsn: about " << StageReport::count(static_cast<std::size_t>(spacing.predicted_points))
                         << " cells predicted (" << integral << ", " << distance << " m)" << std::endl;
 
-      // The nuclei: the user's points, points along every body's boundary, then
-      // random points (one set for all bodies; each point belongs to the body
-      // that contains it).
-      std::vector<dealii::Point<dim>> fixed = extra_points;
-      for (const auto &p : extra_points)
-        {
-          bool inside = false;
-          for (const auto *shape : body_shapes)
-            inside = inside || shape->contains(p, 1e-9 * d_m);
-          std::ostringstream point;
-          point << p;
-          require(inside, "RBSN/Additional points", "the point (" + point.str() + ") lies in no deformable body");
-        }
-      if (points_on_boundary)
-        for (unsigned int s = 0; s < body_shapes.size(); ++s)
-          {
-            std::vector<dealii::Point<dim>> p;
-            if constexpr (dim == 2)
-              p = boundary_points(*body_shapes[s], spacing, boundary_h);
-            else
-              p = boundary_points(*body_shapes[s], spacing, boundary_h, scene.random_seed() + 104729 * s);
-            fixed.insert(fixed.end(), p.begin(), p.end());
-          }
-      // Merge points closer than 1e-6 d_m (corners shared by touching bodies), the
-      // first kept: each point is compared with the kept ones in its and the
-      // neighbouring cells of a hash grid of that size.
-      std::vector<dealii::Point<dim>> points;
-      {
-        const double tolerance = 1e-6 * d_m;
-        using Key              = std::array<long long, dim>;
-        std::map<Key, std::vector<unsigned int>> kept;
-        const auto key = [&](const dealii::Point<dim> &p, const std::array<int, dim> &shift) {
-          Key k;
-          for (unsigned int d = 0; d < dim; ++d)
-            k[d] = static_cast<long long>(std::floor(p[d] / tolerance)) + shift[d];
-          return k;
-        };
-        for (const auto &p : fixed)
-          {
-            bool seen = false;
-            // The 3^dim neighbouring keys, the last coordinate slowest.
-            for (unsigned int m = 0; m < (dim == 2 ? 9u : 27u) && !seen; ++m)
-              {
-                std::array<int, dim> shift;
-                unsigned int         r = m;
-                for (unsigned int d = 0; d < dim; ++d, r /= 3)
-                  shift[d] = static_cast<int>(r % 3) - 1;
-                if (const auto k = kept.find(key(p, shift)); k != kept.end())
-                  for (const unsigned int q : k->second)
-                    seen = seen || p.distance(points[q]) < tolerance;
-              }
-            if (!seen)
-              {
-                kept[key(p, std::array<int, dim>{})].push_back(points.size());
-                points.push_back(p);
-              }
-          }
-      }
+      // The nuclei: the user's points, points along every body's boundary, then random
+      // points (one set for all bodies; each point belongs to the body that contains
+      // it), in one block or block by block.
+      const std::vector<dealii::Point<dim>> fixed = fixed_points();
+      std::vector<std::pair<dealii::Point<dim>, dealii::Point<dim>>> boxes;
+      dealii::Point<dim>                                             lo, hi;
       for (unsigned int s = 0; s < body_shapes.size(); ++s)
         {
-          // Each body is filled in turn, keeping the distance from every point so far.
+          boxes.push_back(body_shapes[s]->bounding_box().get_boundary_points());
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              lo[d] = s == 0 ? boxes[s].first[d] : std::min(lo[d], boxes[s].first[d]);
+              hi[d] = s == 0 ? boxes[s].second[d] : std::max(hi[d], boxes[s].second[d]);
+            }
+        }
+      const MPI_Comm                comm    = scene.mpi_communicator();
+      const unsigned int            n_ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
+      const Blocks::Layout<dim>     layout(lo, hi, sampling_block_side(), boxes);
+      Blocks::Nuclei<dim>           nuclei(layout, comm);
+      if (layout.single())
+        nuclei.hold_all(sample_one_block(fixed));
+      else
+        sample_blocks(fixed, layout, nuclei);
+      n_cells  = nuclei.size();
+      n_blocks = layout.single() ? 1 : layout.size();
+      require(n_cells >= 2,
+              "RBSN/Minimum distance",
+              "leaves room for " + std::to_string(n_cells) +
+                " nucleus in the bodies, and a network needs at least two cells: the minimum "
+                "distance must be well below the size of the bodies (got " + distance + " m)");
+      std::ostringstream blocks;
+      if (!layout.single())
+        blocks << " in " << layout.size() << " blocks of " << layout.side << " m";
+      stage(StageReport::count(n_cells) + " nuclei" + blocks.str());
+
+      // The parts: one per rank, or one for all (every rank runs the whole network) with
+      // the variable-order analysis (one SUNDIALS vector) or fewer cells than ranks.
+      n_parts = analysis == Analysis::variable_order || n_cells < 2 * n_ranks ? 1 : n_ranks;
+      part    = n_parts == 1 ? 0 : dealii::Utilities::MPI::this_mpi_process(comm);
+      require(n_parts == n_ranks || layout.single() || n_ranks == 1,
+              "RBSN/Sampling block size",
+              "a network of several sampling blocks needs at least two cells per MPI rank (" +
+                std::to_string(n_cells) + " cells on " + std::to_string(n_ranks) + " ranks)");
+      if (n_parts == 1)
+        Collective::collectively(MPI_COMM_SELF, [&]() { build_whole_tessellation(nuclei.all()); });
+      else
+        build_local_tessellation(nuclei);
+      stage("Voronoi cells");
+      setup_cells();
+    }
+
+
+
+    template <int dim>
+    std::vector<dealii::Point<dim>>
+    Model<dim>::sample_one_block(const std::vector<dealii::Point<dim>> &fixed) const
+    {
+      // Each body is filled in turn, keeping the distance from every point so far.
+      std::vector<dealii::Point<dim>> points = fixed;
+      for (unsigned int s = 0; s < body_shapes.size(); ++s)
+        {
           std::vector<dealii::Point<dim>> filled;
           if constexpr (dim == 2)
             filled = poisson_disk_points(*body_shapes[s], spacing, points, scene.random_seed() + 7919 * s,
@@ -227,37 +220,199 @@ namespace hysteron
                                          "RBSN/Minimum distance", boundary_h);
           points.swap(filled);
         }
-      require(points.size() >= 2,
-              "RBSN/Minimum distance",
-              "leaves room for " + std::to_string(points.size()) +
-                " nucleus in the bodies, and a network needs at least two cells: the minimum "
-                "distance must be well below the size of the bodies (got " + distance + " m)");
-      stage(StageReport::count(points.size()) + " nuclei");
-      nuclei.swap(points);
-      nuclei_box.assign(2, nuclei[0]);
-      for (const auto &p : nuclei)
+      return points;
+    }
+
+
+
+    template <int dim>
+    void
+    Model<dim>::sample_blocks(const std::vector<dealii::Point<dim>> &fixed,
+                              const Blocks::Layout<dim>             &layout,
+                              Blocks::Nuclei<dim>                   &nuclei) const
+    {
+      const MPI_Comm comm = scene.mpi_communicator();
+      require(analysis != Analysis::variable_order || dealii::Utilities::MPI::n_mpi_processes(comm) == 1,
+              "RBSN/Analysis",
+              "the variable-order analysis integrates the whole network as one SUNDIALS vector on "
+              "every rank, so every rank would sample and hold all of its nuclei; on several MPI "
+              "ranks it takes networks of one sampling block only (at most " +
+                std::to_string(static_cast<long>(single_block_points)) +
+                " points predicted, and no Sampling block size), and this one has about " +
+                std::to_string(static_cast<long>(spacing.predicted_points)) + " in " +
+                std::to_string(layout.size()) + " blocks: run it on one rank");
+      typename Blocks::Nuclei<dim>::Sources                      sources;
+      std::vector<std::unique_ptr<Sampling::BodySampler<dim>>> samplers;
+      Collective::collectively(comm, [&]() {
+        for (const auto *shape : body_shapes)
+          samplers.push_back(
+            std::make_unique<Sampling::BodySampler<dim>>(*shape, spacing, fixed, boundary_h, "RBSN/Minimum distance"));
+      });
+      sources.fixed = &fixed;
+      for (unsigned int s = 0; s < body_shapes.size(); ++s)
+        {
+          sources.bodies.push_back(samplers[s].get());
+          sources.body_boxes.push_back(body_shapes[s]->bounding_box().get_boundary_points());
+        }
+      sources.seed   = scene.random_seed();
+      sources.margin = 2 * spacing.max;
+      const std::vector<double> predicted = spacing.predicted_in_blocks(layout.origin, layout.side, layout.n);
+      for (unsigned int b = 0; b < layout.size(); ++b)
+        sources.predicted.push_back(predicted[layout.linear(b)]);
+      nuclei.sample(sources);
+    }
+
+
+
+    template <int dim>
+    void
+    Model<dim>::build_whole_tessellation(const std::vector<dealii::Point<dim>> &all)
+    {
+      // The whole network on this rank, in the numbering of the nuclei.
+      network = voronoi(all, body_shapes, boundary_h, "Body names");
+      n_owned_cells = all.size();
+      local_nuclei  = all;
+      cell_id.resize(all.size());
+      std::iota(cell_id.begin(), cell_id.end(), 0u);
+      cell_block.resize(all.size());
+      std::iota(cell_block.begin(), cell_block.end(), dof_index(0));
+      facet_id.resize(network.facets.size());
+      std::iota(facet_id.begin(), facet_id.end(), 0ul);
+      n_global_facets = network.facets.size();
+      number_owned_facets();
+    }
+
+
+
+    template <int dim>
+    void
+    Model<dim>::build_local_tessellation(Blocks::Nuclei<dim> &nuclei)
+    {
+      // The nuclei within H of an owned one, the owned ones flagged; their cells are
+      // exact if 2 reach <= H (see the top of the file). A rank whose halo is too narrow
+      // doubles it; the others wait for it in the fetches.
+      const MPI_Comm comm = scene.mpi_communicator();
+      nuclei.partition(n_parts);
+      double                     H    = 2.5 * spacing.max;
+      bool                       done = false;
+      Tessellation<dim>               local;
+      std::vector<std::uint64_t>      ids;
+      std::vector<dealii::Point<dim>> points;
+      std::vector<bool>               own;
+      for (unsigned int attempt = 0;; ++attempt)
+        {
+          nuclei.fetch(H);
+          Collective::collectively(comm, [&]() {
+            if (done)
+              return;
+            nuclei.near_own(H, ids, points, own);
+            if (points.size() < 2)
+              return;
+            local = voronoi(points, body_shapes, boundary_h, "Body names", own);
+            done  = true;
+            for (unsigned int i = 0; i < points.size(); ++i)
+              if (own[i] && 2 * local.cells[i].reach > H * (1 - 1e-12))
+                done = false;
+          });
+          if (dealii::Utilities::MPI::min(done ? 1 : 0, comm) == 1)
+            break;
+          if (attempt > 20)
+            throw RuntimeError("rbsn: the halo of a rank's cells does not reach the nuclei that "
+                               "shape them (a cell wider than " + std::to_string(H) + " m)");
+          if (!done)
+            H *= 2;
+        }
+
+      // The owned cells (ascending numbers), then the ghost cells (the other cells of
+      // the owned facets) in the order of their DoFs.
+      std::vector<int> local_of(ids.size(), -1);
+      cell_id.clear();
+      cell_block.clear();
+      local_nuclei.clear();
+      network.cells.clear();
+      network.facets.clear();
+      for (unsigned int i = 0; i < ids.size(); ++i)
+        if (own[i])
+          {
+            local_of[i] = cell_id.size();
+            cell_id.push_back(ids[i]);
+            cell_block.push_back(nuclei.owner(ids[i]).second);
+            local_nuclei.push_back(points[i]);
+            network.cells.push_back(std::move(local.cells[i]));
+          }
+      n_owned_cells = cell_id.size();
+      std::vector<std::pair<dof_index, unsigned int>> ghosts; // DoF block, index in ids
+      for (const auto &f : local.facets)
+        if (!own[f.b] && local_of[f.b] == -1)
+          {
+            local_of[f.b] = -2;
+            ghosts.emplace_back(nuclei.owner(ids[f.b]).second, f.b);
+          }
+      std::sort(ghosts.begin(), ghosts.end());
+      for (const auto &[block, i] : ghosts)
+        {
+          local_of[i] = cell_id.size();
+          cell_id.push_back(ids[i]);
+          cell_block.push_back(block);
+          local_nuclei.push_back(points[i]);
+        }
+      for (auto &f : local.facets)
+        {
+          f.a = local_of[f.a];
+          f.b = local_of[f.b];
+          network.facets.push_back(std::move(f));
+        }
+      number_owned_facets();
+
+      // The global numbers of the facets: in the order of (a, b) over the whole network,
+      // as one rank numbers them.
+      std::vector<unsigned int> n_up(n_owned_cells);
+      for (unsigned int c = 0; c < n_owned_cells; ++c)
+        n_up[c] = owned_facet_start[c + 1] - owned_facet_start[c];
+      const std::vector<std::uint64_t> first = nuclei.first_facets(n_up);
+      facet_id.resize(network.facets.size());
+      for (unsigned int c = 0; c < n_owned_cells; ++c)
+        for (unsigned int e = owned_facet_start[c]; e < owned_facet_start[c + 1]; ++e)
+          facet_id[e] = first[c] + (e - owned_facet_start[c]);
+      n_global_facets = dealii::Utilities::MPI::sum<unsigned long>(network.facets.size(), comm);
+    }
+
+
+
+    template <int dim>
+    void
+    Model<dim>::number_owned_facets()
+    {
+      // The facets are sorted by (a, b): those of owned cell c are a range.
+      owned_facet_start.assign(n_owned_cells + 1, 0);
+      for (const auto &f : network.facets)
+        ++owned_facet_start[f.a + 1];
+      std::partial_sum(owned_facet_start.begin(), owned_facet_start.end(), owned_facet_start.begin());
+    }
+
+
+
+    template <int dim>
+    void
+    Model<dim>::setup_cells()
+    {
+      // The box of the nuclei (the faces that select cells), the bodies of the local
+      // cells, and the rigid-body mass properties of the owned ones about their nuclei
+      // (eq. 3.12; in 3D the inertia tensor).
+      const auto &bodies = scene.body_descriptions();
+      nuclei_box.assign(2, local_nuclei[0]);
+      for (unsigned int c = 0; c < n_owned_cells; ++c)
         for (unsigned int d = 0; d < dim; ++d)
           {
-            nuclei_box[0][d] = std::min(nuclei_box[0][d], p[d]);
-            nuclei_box[1][d] = std::max(nuclei_box[1][d], p[d]);
+            nuclei_box[0][d] = std::min(nuclei_box[0][d], local_nuclei[c][d]);
+            nuclei_box[1][d] = std::max(nuclei_box[1][d], local_nuclei[c][d]);
           }
-
-      // The parts: one per rank, or one for all (every rank runs the whole network) with
-      // the variable-order analysis (one SUNDIALS vector) or fewer cells than ranks.
-      const MPI_Comm     comm    = scene.mpi_communicator();
-      const unsigned int n_ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
-      n_parts                    = analysis == Analysis::variable_order || nuclei.size() < 2 * n_ranks ? 1 : n_ranks;
-      part                       = n_parts == 1 ? 0 : dealii::Utilities::MPI::this_mpi_process(comm);
-      cell_part                  = n_parts == 1 ? std::vector<unsigned int>(nuclei.size(), 0) : partition_nuclei(n_parts);
-      std::vector<unsigned int> owned;
-      for (unsigned int c = 0; c < nuclei.size(); ++c)
-        if (cell_part[c] == part)
-          owned.push_back(c);
-      collectively(n_parts > 1 ? comm : MPI_COMM_SELF, [&]() { build_local_tessellation(owned); });
-      stage("Voronoi cells");
-
-      // The bodies of the local cells, and the rigid-body mass properties of the owned
-      // ones about their nuclei (eq. 3.12; in 3D the inertia tensor).
+      if (distributed())
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            nuclei_box[0][d] = dealii::Utilities::MPI::min(nuclei_box[0][d], network_communicator());
+            nuclei_box[1][d] = dealii::Utilities::MPI::max(nuclei_box[1][d], network_communicator());
+          }
       const unsigned int n_local = cell_id.size();
       cell_body.assign(n_local, 0);
       const auto lo = bodies[mesh_body[0]].shape.bounding_box().get_boundary_points();
@@ -277,7 +432,7 @@ namespace hysteron
       };
       for (unsigned int c = 0; c < n_local; ++c)
         for (unsigned int s = 0; s < body_shapes.size(); ++s)
-          if (in_body(s, nuclei[cell_id[c]]))
+          if (in_body(s, local_nuclei[c]))
             {
               cell_body[c] = mesh_body[s];
               break;
@@ -309,146 +464,6 @@ namespace hysteron
               cell_inertia[c] = rho * (dealii::trace(S) * dealii::unit_symmetric_tensor<3>() - S);
             }
         }
-    }
-
-
-
-    template <int dim>
-    void
-    Model<dim>::build_local_tessellation(const std::vector<unsigned int> &owned)
-    {
-      const unsigned int n_cells = nuclei.size();
-      n_owned_cells              = owned.size();
-      if (n_parts == 1)
-        {
-          // The whole network on this rank, in the numbering of the nuclei.
-          network = voronoi(nuclei, body_shapes, boundary_h, "Body names");
-          cell_id.resize(n_cells);
-          std::iota(cell_id.begin(), cell_id.end(), 0u);
-          cell_block.resize(n_cells);
-          std::iota(cell_block.begin(), cell_block.end(), dof_index(0));
-          facet_id.resize(network.facets.size());
-          std::iota(facet_id.begin(), facet_id.end(), 0ul);
-          n_global_facets = network.facets.size();
-          return;
-        }
-
-      // The nuclei within H of an owned one (a hash grid of cells H), the owned ones
-      // flagged; their cells are exact if 2 reach <= H (see the top of the file).
-      double             H        = 2.5 * spacing.max;
-      Tessellation<dim>  local;
-      std::vector<unsigned int> local_ids;
-      for (unsigned int attempt = 0;; ++attempt)
-        {
-          std::map<std::array<long long, dim>, std::vector<unsigned int>> grid;
-          const auto key = [&](const dealii::Point<dim> &p) {
-            std::array<long long, dim> k;
-            for (unsigned int d = 0; d < dim; ++d)
-              k[d] = static_cast<long long>(std::floor(p[d] / H));
-            return k;
-          };
-          for (unsigned int c = 0; c < n_cells; ++c)
-            grid[key(nuclei[c])].push_back(c);
-          std::vector<bool> in_set(n_cells, false);
-          for (const unsigned int c : owned)
-            {
-              const auto k = key(nuclei[c]);
-              for (unsigned int m = 0; m < (dim == 2 ? 9u : 27u); ++m)
-                {
-                  auto         q = k;
-                  unsigned int r = m;
-                  for (unsigned int d = 0; d < dim; ++d, r /= 3)
-                    q[d] += static_cast<int>(r % 3) - 1;
-                  if (const auto g = grid.find(q); g != grid.end())
-                    for (const unsigned int p : g->second)
-                      if (!in_set[p] && nuclei[p].distance(nuclei[c]) <= H)
-                        in_set[p] = true;
-                }
-            }
-          local_ids.clear();
-          std::vector<dealii::Point<dim>> points;
-          std::vector<bool>               wanted;
-          for (unsigned int c = 0; c < n_cells; ++c)
-            if (in_set[c] || cell_part[c] == part)
-              {
-                local_ids.push_back(c);
-                points.push_back(nuclei[c]);
-                wanted.push_back(cell_part[c] == part);
-              }
-          if (points.size() >= 2)
-            {
-              local = voronoi(points, body_shapes, boundary_h, "Body names", wanted);
-              bool wide_enough = true;
-              for (unsigned int i = 0; i < points.size(); ++i)
-                if (wanted[i] && 2 * local.cells[i].reach > H * (1 - 1e-12))
-                  wide_enough = false;
-              if (wide_enough)
-                break;
-            }
-          if (attempt > 20)
-            throw RuntimeError("rbsn: the halo of a rank's cells does not reach the nuclei that "
-                               "shape them (a cell wider than " + std::to_string(H) + " m)");
-          H *= 2;
-        }
-
-      // The DoF blocks: each rank's cells in the order of their numbers, rank by rank.
-      std::vector<dof_index> block(n_cells);
-      {
-        std::vector<dof_index> first(n_parts + 1, 0);
-        for (const unsigned int p : cell_part)
-          ++first[p + 1];
-        std::partial_sum(first.begin(), first.end(), first.begin());
-        for (unsigned int c = 0; c < n_cells; ++c)
-          block[c] = first[cell_part[c]]++;
-      }
-      // The owned cells, then the ghost cells (the other cells of the owned facets) in
-      // the order of their blocks.
-      std::vector<int> local_of(n_cells, -1);
-      cell_id = owned;
-      for (unsigned int c = 0; c < owned.size(); ++c)
-        local_of[owned[c]] = c;
-      std::vector<unsigned int> ghosts;
-      for (const auto &f : local.facets)
-        if (const unsigned int b = local_ids[f.b]; cell_part[b] != part && local_of[b] == -1)
-          {
-            local_of[b] = -2;
-            ghosts.push_back(b);
-          }
-      std::sort(ghosts.begin(), ghosts.end(), [&](const unsigned int a, const unsigned int b) { return block[a] < block[b]; });
-      for (const unsigned int g : ghosts)
-        {
-          local_of[g] = cell_id.size();
-          cell_id.push_back(g);
-        }
-      cell_block.resize(cell_id.size());
-      for (unsigned int c = 0; c < cell_id.size(); ++c)
-        cell_block[c] = block[cell_id[c]];
-
-      // The owned cells' geometry and the facets in local numbers.
-      network.cells.clear();
-      network.facets.clear();
-      std::vector<unsigned long> n_up(n_cells, 0); // facets per first cell (owned cells only)
-      for (unsigned int i = 0; i < local_ids.size(); ++i)
-        if (cell_part[local_ids[i]] == part)
-          network.cells.push_back(std::move(local.cells[i]));
-      for (auto &f : local.facets)
-        {
-          ++n_up[local_ids[f.a]];
-          f.a = local_of[local_ids[f.a]];
-          f.b = local_of[local_ids[f.b]];
-          network.facets.push_back(std::move(f));
-        }
-      // The global numbers of the facets: in the order of (a, b) over the whole network,
-      // as one rank numbers them.
-      const MPI_Comm comm = scene.mpi_communicator();
-      const int      ierr = MPI_Allreduce(MPI_IN_PLACE, n_up.data(), n_cells, MPI_UNSIGNED_LONG, MPI_SUM, comm);
-      AssertThrowMPI(ierr);
-      std::vector<unsigned long> first_facet(n_cells + 1, 0);
-      std::partial_sum(n_up.begin(), n_up.end(), first_facet.begin() + 1);
-      n_global_facets = first_facet.back();
-      facet_id.resize(network.facets.size());
-      for (unsigned int e = 0; e < network.facets.size(); ++e)
-        facet_id[e] = first_facet[cell_id[network.facets[e].a]]++;
     }
 
 

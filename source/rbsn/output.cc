@@ -83,7 +83,7 @@ namespace hysteron
       if (c >= 0)
         {
           // The rigid motion of cell c at p: u(p) = u_c + theta x (p - x_c).
-          const dealii::Tensor<1, dim>  r = p - nuclei[cell_id[c]];
+          const dealii::Tensor<1, dim>  r = p - local_nuclei[c];
           std::array<double, n_dofs>    U, V;
           for (unsigned int k = 0; k < n_dofs; ++k)
             {
@@ -164,16 +164,25 @@ namespace hysteron
               what << "the point (" << p << ") lies outside the bodies of the network";
               throw InputError("Output/Probe points", what.str());
             }
-          unsigned int best = 0;
-          for (unsigned int c = 1; c < nuclei.size(); ++c)
-            if (nuclei[c].distance(p) < nuclei[best].distance(p))
-              best = c;
-          probe_global_cell.push_back(best);
-          int cell = -1;
+          // The nearest nucleus of each rank's own cells (ascending numbers: the lowest of
+          // equals), then over the ranks the nearest, and the lowest number of equals.
+          int    cell     = -1;
+          double distance = std::numeric_limits<double>::max();
           for (unsigned int c = 0; c < n_owned_cells; ++c)
-            if (cell_id[c] == best)
-              cell = c;
-          probe_cell.push_back(cell);
+            if (local_nuclei[c].distance(p) < distance)
+              {
+                distance = local_nuclei[c].distance(p);
+                cell     = c;
+              }
+          // (MPI_UNSIGNED_LONG_LONG: Debian 12's Open MPI takes MPI_MIN of MPI_UNSIGNED_LONG
+          // values above 2^63 for negative ones.)
+          const double                    closest = dealii::Utilities::MPI::min(distance, comm);
+          std::vector<unsigned long long> best{cell >= 0 && distance == closest ?
+                                                 cell_id[cell] :
+                                                 std::numeric_limits<unsigned long long>::max()};
+          Collective::all_reduce(best, MPI_MIN, comm);
+          probe_global_cell.push_back(best[0]);
+          probe_cell.push_back(cell >= 0 && cell_id[cell] == best[0] ? cell : -1);
           int facet = -1;
           for (unsigned int e = 0; e < network.facets.size(); ++e)
             if (facet < 0 || network.facets[e].midpoint.distance(p) < network.facets[facet].midpoint.distance(p))
@@ -247,7 +256,7 @@ namespace hysteron
       for (unsigned int r = 0; r < regions.size(); ++r)
         {
           for (unsigned int c = 0; c < n_owned_cells; ++c)
-            if (regions[r].contains(nuclei[cell_id[c]], 1e-9 * scale))
+            if (regions[r].contains(local_nuclei[c], 1e-9 * scale))
               totals[2 * r] += cell_mass[c];
           for (unsigned int e = 0; e < network.facets.size(); ++e)
             if (regions[r].contains(network.facets[e].midpoint, 1e-9 * scale))
@@ -263,9 +272,9 @@ namespace hysteron
         {
           double *avg = averages.data() + r * (1 + n_values);
           for (unsigned int c = 0; c < n_owned_cells; ++c)
-            if (regions[r].contains(nuclei[cell_id[c]], 1e-9 * scale))
+            if (regions[r].contains(local_nuclei[c], 1e-9 * scale))
               {
-                point_values(c, -1, nuclei[cell_id[c]], values.data());
+                point_values(c, -1, local_nuclei[c], values.data());
                 avg[0] += cell_mass[c];
                 for (unsigned int k = 0; k < n_cell_columns; ++k)
                   avg[1 + k] += cell_mass[c] * values[k];
@@ -363,7 +372,7 @@ namespace hysteron
         std::array<double, n_dofs> U;
         for (unsigned int k = 0; k < n_dofs; ++k)
           U[k] = u.local_element(n_dofs * c + k);
-        const dealii::Tensor<1, dim> w = rigid_motion<dim>(U, p - nuclei[cell_id[c]]);
+        const dealii::Tensor<1, dim> w = rigid_motion<dim>(U, p - local_nuclei[c]);
         points.push_back(p);
         for (unsigned int d = 0; d < dim; ++d)
           displacement.push_back(w[d]);
@@ -645,6 +654,44 @@ namespace hysteron
       for (std::size_t k = 0; k + width <= all.size(); k += width)
         ordered[static_cast<std::size_t>(all[k])].assign(all.begin() + k + 1, all.begin() + k + width);
       Output::CsvWriter out(method.output_file("springs.csv"), columns);
+      for (const auto &row : ordered)
+        out.add_row(row);
+      out.commit();
+    }
+
+
+
+    template <int dim>
+    void
+    Model<dim>::write_cell_table() const
+    {
+      // Every rank's cells (number first) to rank 0, which writes them in order.
+      std::vector<std::string> columns{"cell", "x", "y"};
+      if (dim == 3)
+        columns.push_back("z");
+      columns.insert(columns.end(), {"body", dim == 2 ? "area" : "volume", "u_x", "u_y"});
+      if constexpr (dim == 2)
+        columns.push_back("theta");
+      else
+        columns.insert(columns.end(), {"u_z", "theta_x", "theta_y", "theta_z"});
+      std::vector<double> rows;
+      for (unsigned int c = 0; c < n_owned_cells; ++c)
+        {
+          rows.push_back(cell_id[c]);
+          for (unsigned int d = 0; d < dim; ++d)
+            rows.push_back(local_nuclei[c][d]);
+          rows.push_back(cell_body[c]);
+          rows.push_back(cell_measure(c));
+          for (unsigned int k = 0; k < n_dofs; ++k)
+            rows.push_back(u.local_element(n_dofs * c + k));
+        }
+      const std::vector<double> all = distributed() ? Collective::gather(rows, network_communicator(), 0) : rows;
+      if (!scene.is_root())
+        return;
+      std::vector<std::vector<double>> ordered(n_cells);
+      for (std::size_t k = 0; k + columns.size() <= all.size(); k += columns.size())
+        ordered[static_cast<std::size_t>(all[k])].assign(all.begin() + k, all.begin() + k + columns.size());
+      Output::CsvWriter out(method.output_file("cells.csv"), columns);
       for (const auto &row : ordered)
         out.add_row(row);
       out.commit();

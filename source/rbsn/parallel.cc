@@ -1,5 +1,5 @@
 // The RBSN under MPI. The network is distributed (network.cc): each rank has its own
-// cells (a part of a coordinate bisection of the nuclei), the facets whose first cell
+// cells (a share of the cells along the sampling blocks), the facets whose first cell
 // is its own, and the neighbouring cells of other ranks as ghosts. The DoF vectors are
 // distributed vectors over the owned and ghost cells' DoFs; each rank evaluates the
 // spring laws of its facets and assembles them into a distributed Trilinos matrix (the
@@ -47,7 +47,7 @@ namespace hysteron
     Model<dim>::setup_parallel_system()
     {
       const MPI_Comm  comm = network_communicator();
-      const dof_index n    = n_dofs * nuclei.size();
+      const dof_index n    = n_dofs * n_cells;
       // The owned DoFs are one range (the cells' blocks are numbered rank by rank); the
       // relevant ones add the ghost cells'.
       owned_dofs.clear();
@@ -84,7 +84,7 @@ namespace hysteron
       parallel_matrix.reinit(owned_dofs, owned_dofs, dsp, comm);
       if (distributed())
         scene.console() << "rbsn: " << n_parts << " MPI ranks, " << network.facets.size() << " of "
-                        << n_global_facets << " facets and " << n_owned_cells << " of " << nuclei.size()
+                        << n_global_facets << " facets and " << n_owned_cells << " of " << n_cells
                         << " cells on rank 0" << std::endl;
     }
 
@@ -316,7 +316,7 @@ namespace hysteron
               const auto                   g = TrilinosWrappers::global_index(map, i);
               const unsigned int           k = g % n_dofs;
               const unsigned int           c = (g - owned_dofs.nth_index_in_set(0)) / n_dofs;
-              const dealii::Tensor<1, dim> r = nuclei[cell_id[c]] - centre;
+              const dealii::Tensor<1, dim> r = local_nuclei[c] - centre;
               for (unsigned int m = 0; m < dim; ++m)
                 null_space[m * n_local + i] = k == m ? 1.0 : 0.0;
               if constexpr (dim == 2)

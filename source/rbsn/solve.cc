@@ -1,4 +1,5 @@
 #include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
 #include <deal.II/lac/full_matrix.h>
 
 #include <hysteron/rbsn/model.h>
@@ -581,7 +582,7 @@ namespace hysteron
       const unsigned int n_owned = u.locally_owned_size();
       for (unsigned int c = 0; c < n_owned_cells; ++c)
         {
-          const auto w = bodies[cell_body[c]].velocity_at(nuclei[cell_id[c]]);
+          const auto w = bodies[cell_body[c]].velocity_at(local_nuclei[c]);
           for (unsigned int d = 0; d < dim; ++d)
             v.local_element(n_dofs * c + d) = w[d];
         }
@@ -665,18 +666,33 @@ namespace hysteron
       setup_springs();
       stage(StageReport::count(n_global_facets) + " facets' springs");
       setup_system();
-      stage("sparsity pattern of " + StageReport::count(n_dofs * nuclei.size()) + " DoFs");
+      stage("sparsity pattern of " + StageReport::count(n_dofs * n_cells) + " DoFs");
       setup_conditions();
       check_supports();
       update_fragments();
       locate_probes();
       stage("supports, loads and probes");
-      scene.console() << "rbsn: " << nuclei.size() << " cells, " << n_global_facets << " facets (";
+      if (stage.enabled())
+        {
+          // The set-up's peak resident memory of the ranks (VmHWM), the least and the most.
+          dealii::Utilities::System::MemoryStats memory;
+          dealii::Utilities::System::get_memory_stats(memory);
+          const MPI_Comm     comm = scene.mpi_communicator();
+          const double       mb   = memory.VmHWM / 1024.0;
+          std::ostringstream line;
+          line << std::fixed << std::setprecision(0) << "rbsn: set-up peak memory per rank "
+               << dealii::Utilities::MPI::min(mb, comm) << " ... " << dealii::Utilities::MPI::max(mb, comm) << " MB";
+          scene.console() << line.str() << std::endl;
+        }
+      scene.console() << "rbsn: " << n_cells << " cells, " << n_global_facets << " facets (";
       if (spacing.is_constant())
         scene.console() << "d_m = " << d_m;
       else
         scene.console() << "d = " << spacing.min << " ... " << spacing.max;
-      scene.console() << " m), " << n_dofs * nuclei.size() << " DoFs" << std::endl;
+      scene.console() << " m";
+      if (n_blocks > 1)
+        scene.console() << ", sampled in " << n_blocks << " blocks";
+      scene.console() << "), " << n_dofs * n_cells << " DoFs" << std::endl;
       if ((analysis == Analysis::quasi_static || analysis == Analysis::implicit_dynamics) &&
           !consistent_tangent && scene.is_root())
         std::cerr << "hysteron: warning: RBSN: the springs' tangent is not the algorithmic one "
@@ -931,6 +947,8 @@ namespace hysteron
     {
       if (spring_table)
         write_spring_table();
+      if (cell_table)
+        write_cell_table();
       // The load-displacement curves of the history sets (rank 0; a warning, never an error).
       tables.flush();
       for (const auto &warning : tables.draw_histories())

@@ -49,7 +49,7 @@ namespace hysteron
           std::vector<double> label(n_parts_here, std::numeric_limits<double>::max());
           for (unsigned int c = 0; c < n_local; ++c)
             label[part_of[c]] = std::min(label[part_of[c]], double(cell_id[c]));
-          dealii::IndexSet owned(nuclei.size()), relevant(nuclei.size());
+          dealii::IndexSet owned(n_cells), relevant(n_cells);
           if (n_owned_cells > 0)
             owned.add_range(cell_block[0], cell_block[0] + n_owned_cells);
           relevant = owned;
@@ -103,8 +103,8 @@ namespace hysteron
           measure[p] += cell_measure(c);
           for (unsigned int d = 0; d < dim; ++d)
             {
-              lo[p * dim + d] = std::min(lo[p * dim + d], nuclei[cell_id[c]][d]);
-              hi[p * dim + d] = std::max(hi[p * dim + d], nuclei[cell_id[c]][d]);
+              lo[p * dim + d] = std::min(lo[p * dim + d], local_nuclei[c][d]);
+              hi[p * dim + d] = std::max(hi[p * dim + d], local_nuclei[c][d]);
             }
         }
       if (distributed())
@@ -141,7 +141,7 @@ namespace hysteron
             if (k >= dim)
               check.add_rotation(part_of[c], k - dim);
             else
-              check.add_displacement(part_of[c], nuclei[cell_id[c]], k);
+              check.add_displacement(part_of[c], local_nuclei[c], k);
           }
       if (distributed())
         check.sum(comm);

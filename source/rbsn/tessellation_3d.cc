@@ -53,13 +53,16 @@ namespace hysteron
       class Sampler
       {
       public:
-        Sampler(const Box &box, const Spacing<3> &d)
+        /// The grid over @p box and a margin of 2 d_max, at most the box's size, or
+        /// of @p block_margin >= 0 (a block of a tiled network: see free()).
+        Sampler(const Box &box, const Spacing<3> &d, const double block_margin = -1)
           : d(d)
+          , refuse_wide(block_margin >= 0)
         {
           double size = 0;
           for (unsigned int k = 0; k < 3; ++k)
             size = std::max(size, box.hi[k] - box.lo[k]);
-          margin = std::min(2 * d.max, size);
+          margin = refuse_wide ? block_margin : std::min(2 * d.max, size);
           double volume = 1;
           for (unsigned int k = 0; k < 3; ++k)
             {
@@ -160,6 +163,8 @@ namespace hysteron
 
         /// Whether p keeps its distance from every point and lies outside the forbidden
         /// balls; d(p) in @p dp. @p inside (the domain) is asked only for an uncovered p.
+        /// Where d(p) exceeds the margin, the points beyond the grid (far) are checked one
+        /// by one, or in a block such a trial is refused (no point beyond it is known).
         template <class Inside>
         bool
         free(const Point &p, double &dp, const Inside &inside) const
@@ -181,9 +186,13 @@ namespace hysteron
                       return false;
                   }
           if (dp > margin)
-            for (const auto &q : far)
-              if (q.distance(p) < dp) // d(q) is not needed: the stricter test
+            {
+              if (refuse_wide)
                 return false;
+              for (const auto &q : far)
+                if (q.distance(p) < dp) // d(q) is not needed: the stricter test
+                  return false;
+            }
           if (!ball_head.empty())
             for (int z = -1; z <= 1; ++z)
               for (int y = -1; y <= 1; ++y)
@@ -243,6 +252,7 @@ namespace hysteron
         }
 
         const Spacing<3>   &d;
+        const bool          refuse_wide;
         Point               lo, hi;
         double              margin = 0, cell = 0, shrink = 1;
         int                 n[3];
@@ -522,6 +532,143 @@ namespace hysteron
 
 
 
+    namespace
+    {
+      /**
+       * The random points of the 3D Poisson-disk sampling (poisson_disk_points()) in
+       * @p domain, the @p fixed points in the grid and the front, the @p balls
+       * forbidden; with @p clip in the part of the domain in one block of a tiled
+       * network (the trials outside the block refused, the darts thrown into it only).
+       */
+      std::vector<Point>
+      sample_3d(const Polyhedral::Domain                    &domain,
+                const Spacing<3>                            &d,
+                const std::vector<Point>                    &fixed,
+                const std::vector<std::pair<Point, double>> &balls,
+                const std::uint64_t                          seed,
+                const Sampling::Clip<3>                     *clip)
+      {
+        Box box = domain.box;
+        if (clip)
+          {
+            const auto block = clip->box();
+            for (unsigned int k = 0; k < 3; ++k)
+              {
+                box.lo[k] = std::max(box.lo[k], block.first[k]);
+                box.hi[k] = std::min(box.hi[k], block.second[k]);
+                if (box.lo[k] > box.hi[k])
+                  return {};
+              }
+          }
+        Sampler grid(box, d, clip ? clip->margin : -1);
+        for (const auto &p : fixed)
+          grid.add(p, d(p));
+        // The fixed points on the boundary own it: no random point may come closer to
+        // a piece of it than they are.
+        grid.forbid(balls);
+        const auto in_domain = [&](const Point &p) { return (!clip || clip->contains(p)) && domain.contains(p); };
+        // Whether the cube [corner, corner + size] meets the box (where darts go).
+        const auto meets = [&](const Point &corner, const double size) {
+          for (unsigned int k = 0; k < 3; ++k)
+            if (std::max(corner[k], box.lo[k]) > std::min(corner[k] + size, box.hi[k]))
+              return false;
+          return true;
+        };
+
+        // Bridson: grow from active points by trials in the shell [d, 2 d] around them
+        // (uniform directions) until the front dies out.
+        std::vector<unsigned int> active;
+        for (unsigned int k = 0; k < grid.points.size(); ++k)
+          active.push_back(k);
+        std::vector<Point> result;
+        std::mt19937_64    rng(seed);
+        const auto         try_add = [&](const Point &p) {
+          double dp;
+          if (!grid.free(p, dp, in_domain))
+            return false;
+          active.push_back(grid.points.size());
+          grid.add(p, dp);
+          result.push_back(p);
+          return true;
+        };
+        // Uniform directions: z = cos(theta) uniform in [-1, 1], phi in [0, 2 pi).
+        const auto shell = [&](const Point &c, const double dc) {
+          const double r = dc * (1 + uniform(rng)), z = 2 * uniform(rng) - 1, phi = 2 * M_PI * uniform(rng);
+          const double s = std::sqrt(std::max(0.0, 1 - z * z));
+          return Point(c[0] + r * s * std::cos(phi), c[1] + r * s * std::sin(phi), c[2] + r * z);
+        };
+        const auto grow = [&]() { Sampling::grow_front(active, grid.points, grid.radius, rng, shell, try_add); };
+        grow();
+        // Up to @p trials random points in a cube (its part in the box); the first that
+        // is free is added and the front grows from it.
+        const auto darts = [&](const Point &corner, const double size, const unsigned int trials) {
+          Point a, b;
+          for (unsigned int k = 0; k < 3; ++k)
+            {
+              a[k] = std::max(corner[k], box.lo[k]);
+              b[k] = std::min(corner[k] + size, box.hi[k]);
+              if (a[k] > b[k])
+                return;
+            }
+          const auto draw = [&]() {
+            const double u = uniform(rng), v = uniform(rng), w = uniform(rng);
+            return Point(a[0] + u * (b[0] - a[0]), a[1] + v * (b[1] - a[1]), a[2] + w * (b[2] - a[2]));
+          };
+          Sampling::throw_darts(trials, draw, try_add, grow);
+        };
+        const auto cube_covered = [&](const Point &corner, const double size) {
+          Point corners[8];
+          for (unsigned int c = 0; c < 8; ++c)
+            corners[c] = corner + Vector({(c & 1) * size, ((c >> 1) & 1) * size, ((c >> 2) & 1) * size});
+          return grid.covers(corners, 8);
+        };
+        // The gaps the front left: 30 trials in every cube that no exclusion ball
+        // covers, in a fixed order, and the front again from each point found.
+        std::vector<std::pair<Point, double>> cubes; // corner, size: the gaps left
+        for (int k = 0; k < grid.n[2]; ++k)
+          for (int j = 0; j < grid.n[1]; ++j)
+            for (int i = 0; i < grid.n[0]; ++i)
+              if (!grid.covered[grid.index(i, j, k)])
+                {
+                  const Point corner = grid.lo + grid.cell * Vector({1.0 * i, 1.0 * j, 1.0 * k});
+                  if (clip && !meets(corner, grid.cell))
+                    continue;
+                  darts(corner, grid.cell, 30);
+                  if (!grid.covered[grid.index(i, j, k)])
+                    cubes.emplace_back(corner, grid.cell);
+                }
+        // The slivers between exclusion balls: split every cube that is not covered (nor
+        // outside the domain at its corners and centre) into 8 and throw 10 darts into
+        // each, for 2 levels (as the 2D sampling does with quarters).
+        for (unsigned int level = 0; level < 2 && !cubes.empty(); ++level)
+          {
+            std::vector<std::pair<Point, double>> octants;
+            for (const auto &q : cubes)
+              for (unsigned int c = 0; c < 8; ++c)
+                {
+                  const double h = 0.5 * q.second;
+                  const Point  x0 = q.first + Vector({(c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h});
+                  bool         inside = domain.contains(x0 + Vector({0.5 * h, 0.5 * h, 0.5 * h}));
+                  for (unsigned int e = 0; e < 8 && !inside; ++e)
+                    inside = domain.contains(x0 + Vector({(e & 1) * h, ((e >> 1) & 1) * h, ((e >> 2) & 1) * h}));
+                  if (inside && (!clip || meets(x0, h)) && !cube_covered(x0, h))
+                    octants.emplace_back(x0, h);
+                }
+            cubes.clear();
+            for (const auto &q : octants)
+              if (!cube_covered(q.first, q.second))
+                {
+                  darts(q.first, q.second, 10);
+                  if (!cube_covered(q.first, q.second))
+                    cubes.push_back(q);
+                }
+          }
+        return result;
+      }
+    } // namespace
+
+
+
     std::vector<dealii::Point<3>>
     poisson_disk_points(const Geometry::Region<3>           &region,
                         const Spacing<3>                    &d,
@@ -544,104 +691,58 @@ namespace hysteron
           << Spacing<3>::density << " int 1/d^3 dV over the body; at most 5e6)";
         require(predicted <= 5e6, where, s.str());
       }
-      const Box &box = domain.box;
-      Sampler    grid(box, d);
-      for (const auto &p : fixed)
-        grid.add(p, d(p));
-      // The fixed points on the boundary own it: no random point may come closer to
-      // a piece of it than they are.
-      grid.forbid(boundary_balls(domain, boundary, fixed, d));
-      const auto in_domain = [&](const Point &p) { return domain.contains(p); };
-
-      // Bridson: grow from active points by trials in the shell [d, 2 d] around them
-      // (uniform directions) until the front dies out.
-      std::vector<unsigned int> active;
-      for (unsigned int k = 0; k < grid.points.size(); ++k)
-        active.push_back(k);
-      std::vector<Point> result;
-      std::mt19937_64    rng(seed);
-      const auto         try_add = [&](const Point &p) {
-        double dp;
-        if (!grid.free(p, dp, in_domain))
-          return false;
-        active.push_back(grid.points.size());
-        grid.add(p, dp);
-        result.push_back(p);
-        return true;
-      };
-      // Uniform directions: z = cos(theta) uniform in [-1, 1], phi in [0, 2 pi).
-      const auto shell = [&](const Point &c, const double dc) {
-        const double r = dc * (1 + uniform(rng)), z = 2 * uniform(rng) - 1, phi = 2 * M_PI * uniform(rng);
-        const double s = std::sqrt(std::max(0.0, 1 - z * z));
-        return Point(c[0] + r * s * std::cos(phi), c[1] + r * s * std::sin(phi), c[2] + r * z);
-      };
-      const auto grow = [&]() { Sampling::grow_front(active, grid.points, grid.radius, rng, shell, try_add); };
-      grow();
-      // Up to @p trials random points in a cube (its part in the domain's box); the
-      // first that is free is added and the front grows from it.
-      const auto darts = [&](const Point &corner, const double size, const unsigned int trials) {
-        Point a, b;
-        for (unsigned int k = 0; k < 3; ++k)
-          {
-            a[k] = std::max(corner[k], box.lo[k]);
-            b[k] = std::min(corner[k] + size, box.hi[k]);
-            if (a[k] > b[k])
-              return;
-          }
-        const auto draw = [&]() {
-          const double u = uniform(rng), v = uniform(rng), w = uniform(rng);
-          return Point(a[0] + u * (b[0] - a[0]), a[1] + v * (b[1] - a[1]), a[2] + w * (b[2] - a[2]));
-        };
-        Sampling::throw_darts(trials, draw, try_add, grow);
-      };
-      const auto cube_covered = [&](const Point &corner, const double size) {
-        Point corners[8];
-        for (unsigned int c = 0; c < 8; ++c)
-          corners[c] = corner + Vector({(c & 1) * size, ((c >> 1) & 1) * size, ((c >> 2) & 1) * size});
-        return grid.covers(corners, 8);
-      };
-      // The gaps the front left: 30 trials in every cube that no exclusion ball
-      // covers, in a fixed order, and the front again from each point found.
-      std::vector<std::pair<Point, double>> cubes; // corner, size: the gaps left
-      for (int k = 0; k < grid.n[2]; ++k)
-        for (int j = 0; j < grid.n[1]; ++j)
-          for (int i = 0; i < grid.n[0]; ++i)
-            if (!grid.covered[grid.index(i, j, k)])
-              {
-                const Point corner = grid.lo + grid.cell * Vector({1.0 * i, 1.0 * j, 1.0 * k});
-                darts(corner, grid.cell, 30);
-                if (!grid.covered[grid.index(i, j, k)])
-                  cubes.emplace_back(corner, grid.cell);
-              }
-      // The slivers between exclusion balls: split every cube that is not covered (nor
-      // outside the domain at its corners and centre) into 8 and throw 10 darts into
-      // each, for 2 levels (as the 2D sampling does with quarters).
-      for (unsigned int level = 0; level < 2 && !cubes.empty(); ++level)
-        {
-          std::vector<std::pair<Point, double>> octants;
-          for (const auto &q : cubes)
-            for (unsigned int c = 0; c < 8; ++c)
-              {
-                const double h = 0.5 * q.second;
-                const Point  x0 = q.first + Vector({(c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h});
-                bool         inside = domain.contains(x0 + Vector({0.5 * h, 0.5 * h, 0.5 * h}));
-                for (unsigned int e = 0; e < 8 && !inside; ++e)
-                  inside = domain.contains(x0 + Vector({(e & 1) * h, ((e >> 1) & 1) * h, ((e >> 2) & 1) * h}));
-                if (inside && !cube_covered(x0, h))
-                  octants.emplace_back(x0, h);
-              }
-          cubes.clear();
-          for (const auto &q : octants)
-            if (!cube_covered(q.first, q.second))
-              {
-                darts(q.first, q.second, 10);
-                if (!cube_covered(q.first, q.second))
-                  cubes.push_back(q);
-              }
-        }
+      std::vector<Point> result = sample_3d(domain, d, fixed, boundary_balls(domain, boundary, fixed, d), seed, nullptr);
       result.insert(result.begin(), fixed.begin(), fixed.end());
       return result;
     }
+
+
+
+    namespace Sampling
+    {
+      struct BodySampler3::Data
+      {
+        const Spacing<3>                      &d;
+        Polyhedral::Domain                     domain;
+        std::vector<std::pair<Point, double>> balls; ///< of the network's fixed points
+      };
+
+
+
+      BodySampler3::BodySampler3(const Geometry::Region<3> &body,
+                                 const Spacing<3>          &d,
+                                 const std::vector<Point>  &fixed,
+                                 const double               boundary_h,
+                                 const std::string         &where)
+        : data(new Data{d, Polyhedral::Domain({&body}, boundary_h > 0 ? boundary_h : 0.25 * d.min, where), {}})
+      {
+        data->balls = boundary_balls(data->domain, data->domain.boundary(), fixed, d);
+      }
+
+
+
+      BodySampler3::~BodySampler3() = default;
+
+
+
+      std::vector<Point>
+      BodySampler3::operator()(const std::vector<Point> &known, const std::uint64_t seed, const Clip<3> &clip) const
+      {
+        // The forbidden balls that reach the block's grid (the block and its margin).
+        const auto             block = clip.box();
+        std::vector<std::pair<Point, double>> near;
+        for (const auto &b : data->balls)
+          {
+            bool meets = true;
+            for (unsigned int k = 0; k < 3 && meets; ++k)
+              meets = b.first[k] >= block.first[k] - clip.margin - b.second &&
+                      b.first[k] <= block.second[k] + clip.margin + b.second;
+            if (meets)
+              near.push_back(b);
+          }
+        return sample_3d(data->domain, data->d, known, near, seed, &clip);
+      }
+    } // namespace Sampling
 
 
 

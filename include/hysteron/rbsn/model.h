@@ -25,6 +25,7 @@
 #include <hysteron/scene/tables.h>
 
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -36,6 +37,14 @@ namespace hysteron
 
   namespace RBSN
   {
+    namespace Blocks
+    {
+      template <int dim>
+      class Layout;
+      template <int dim>
+      class Nuclei;
+    } // namespace Blocks
+
     enum class Analysis
     {
       linear_static,     ///< elastic springs, one solve per step
@@ -104,16 +113,20 @@ namespace hysteron
      * The scene on the network (see Solver), in 2D (cells with the DoFs u, v, theta)
      * or 3D (u_x, u_y, u_z, theta_x, theta_y, theta_z).
      *
-     * Under MPI the network is distributed: the nuclei (the points, 2 or 3 doubles per
-     * cell, and the rank of every cell) are the only data every rank holds for the
-     * whole network. The cells are split over the ranks by recursive coordinate
-     * bisection of the nuclei; each rank builds the Voronoi cells of its own nuclei
-     * from them and a halo of the nuclei around them, and owns the facets whose first
-     * cell (the lower number) is its own. The DoF vectors are distributed vectors with
-     * the neighbouring ("ghost") cells of other ranks, the tangent is a Trilinos matrix
-     * of the owned rows. The cells of a rank are numbered 0, 1, ...: its own first (in
-     * the order of their global numbers), then its ghost cells (in the order of their
-     * DoFs).
+     * Under MPI the network is distributed. A large network is sampled block by block
+     * (blocks.cc), each rank holding the nuclei of its blocks and of those around its
+     * cells; a small one (one block) is sampled by every rank. The cells have global
+     * numbers, the same on any number of ranks (block by block); each rank owns a
+     * consecutive share of them along the blocks' Hilbert order (a block two ranks share
+     * split by coordinate bisection), builds the Voronoi cells of its own nuclei from
+     * them and a halo of the nuclei around them, and owns the facets whose first cell
+     * (the lower number) is its own. The DoF vectors are distributed vectors with the
+     * neighbouring ("ghost") cells of other ranks, the tangent is a Trilinos matrix of
+     * the owned rows. The cells of a rank are numbered 0, 1, ...: its own first (in the
+     * order of their global numbers), then its ghost cells (in the order of their
+     * DoFs). The facets of owned cell c (those whose lower cell it is) are the local
+     * facets [owned_facet_start[c], owned_facet_start[c + 1]), in the order of their
+     * upper cells.
      */
     template <int dim>
     class Model
@@ -175,8 +188,13 @@ namespace hysteron
       std::size_t
       n_global_cells() const
       {
-        return nuclei.size();
+        return n_cells;
       }
+
+      /// A network predicted to have at most this many points (the integral of
+      /// Spacing::predicted_points) is one sampling block, unless `Sampling block size`
+      /// is given: every rank samples it, as before the tiling (doc/rbsn.md).
+      static constexpr double single_block_points = dim == 2 ? 2e4 : 1e4;
 
     private:
       using Vector       = dealii::LinearAlgebra::distributed::Vector<double>;
@@ -202,17 +220,39 @@ namespace hysteron
       };
 
       // Set-up.
-      /// The nuclei (every rank), their partition over the ranks, and this rank's cells,
-      /// ghost cells and facets with their mass properties (network.cc).
+      /// The nuclei, their partition over the ranks, and this rank's cells, ghost cells
+      /// and facets with their mass properties (network.cc).
       void
       build_network();
-      /// This rank's part of the tessellation: the cells of @p owned (ascending global
-      /// numbers) and their facets, from a halo of nuclei around them.
+      /// The user's and the boundary points, merged (every rank).
+      std::vector<dealii::Point<dim>>
+      fixed_points() const;
+      /// The side of the sampling blocks: `Sampling block size`, or from the predicted
+      /// points (0: one block).
+      double
+      sampling_block_side() const;
+      /// The nuclei of a network of one block: the @p fixed points and every body's
+      /// random points in turn.
+      std::vector<dealii::Point<dim>>
+      sample_one_block(const std::vector<dealii::Point<dim>> &fixed) const;
+      /// The random points of a tiled network, block by block (collective).
       void
-      build_local_tessellation(const std::vector<unsigned int> &owned);
-      /// Recursive coordinate bisection of the nuclei into @p n_parts parts of equal size.
-      std::vector<unsigned int>
-      partition_nuclei(unsigned int n_parts) const;
+      sample_blocks(const std::vector<dealii::Point<dim>> &fixed,
+                    const Blocks::Layout<dim>             &layout,
+                    Blocks::Nuclei<dim>                   &nuclei) const;
+      /// The whole network on this rank, from every nucleus (@p all).
+      void
+      build_whole_tessellation(const std::vector<dealii::Point<dim>> &all);
+      /// This rank's part of the tessellation: its cells (a share of the cells of
+      /// @p nuclei), their ghost cells and facets, from a halo of nuclei around them.
+      void
+      build_local_tessellation(Blocks::Nuclei<dim> &nuclei);
+      /// owned_facet_start from the facets (sorted by their cells).
+      void
+      number_owned_facets();
+      /// The box of the nuclei, the cells' bodies and the owned cells' mass properties.
+      void
+      setup_cells();
       void
       setup_springs();
       void
@@ -383,6 +423,9 @@ namespace hysteron
       open_tables();
       void
       write_spring_table() const;
+      /// cells.csv: every cell (gathered on rank 0 in the order of the cells).
+      void
+      write_cell_table() const;
       /// The probe values of local cell @p c (-1: none) at @p x and facet @p e (-1: none)
       /// into @p out (the cell's columns, then the facet's; zeros where none).
       void
@@ -428,6 +471,7 @@ namespace hysteron
 
       // Parameters.
       Spacing<dim>                    spacing; ///< `Minimum distance` d(x), sampled by build_network()
+      double                          block_size = 0; ///< `Sampling block size` [m]; 0: automatic
       double                          d_m = 0; ///< the constant d_m, or the smallest d of a function
       bool                            points_on_boundary = true;
       std::vector<dealii::Point<dim>> extra_points;
@@ -444,6 +488,7 @@ namespace hysteron
       FractureParameters              fracture;
       VariableOrderParameters         variable_order;
       bool                            spring_table = false;
+      bool                            cell_table   = false; ///< `Write cell table`
       double                          reuse_tolerance = 0; ///< `Tangent reuse tolerance`
       bool                            incremental_assembly = true; ///< `Incremental assembly`
       std::string                     distributed_solver;  ///< `Distributed direct solver`
@@ -452,11 +497,11 @@ namespace hysteron
       unsigned int                    solver_max_iterations = 1000;
       unsigned long                   n_linear_iterations = 0;
 
-      // The whole network (every rank): the nuclei and the rank of every cell.
-      std::vector<dealii::Point<dim>> nuclei;
-      std::vector<unsigned int>       cell_part;
-      std::vector<dealii::Point<dim>> nuclei_box; ///< the lower and upper corner of the nuclei
+      // The whole network: its numbers of cells and facets, the box of its nuclei.
+      std::uint64_t                   n_cells         = 0;
+      unsigned int                    n_blocks        = 1; ///< of the sampling (blocks.cc)
       unsigned long                   n_global_facets = 0;
+      std::vector<dealii::Point<dim>> nuclei_box; ///< the lower and upper corner of the nuclei
 
       // This rank's network: its cells (rigid bodies, the owned ones first), facets
       // (springs) and bodies. network.cells holds the owned cells' geometry,
@@ -464,6 +509,8 @@ namespace hysteron
       Tessellation<dim>                          network;
       unsigned int                               n_owned_cells = 0;
       std::vector<unsigned int>                  cell_id;    ///< global number of every local cell
+      std::vector<dealii::Point<dim>>            local_nuclei; ///< the nucleus of every local cell
+      std::vector<unsigned int>                  owned_facet_start; ///< see the class's description
       std::vector<dof_index>                     cell_block; ///< its DoFs are n_dofs block + k
       std::vector<unsigned long>                 facet_id;   ///< global number of every owned facet
       std::vector<unsigned int>                  cell_body;  ///< of every local cell

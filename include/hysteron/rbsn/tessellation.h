@@ -75,10 +75,26 @@ namespace hysteron
       double gradient = 0;
       /// density int d^-dim over the bodies (after sample()).
       double predicted_points = 0;
+      /// The area (2D) or volume (3D) of the bodies (after sample(); the midpoint rule).
+      double measure = 0;
+
+      /**
+       * The predicted points of the samples of sample() in each block of a tiling: the
+       * blocks of side @p size from @p origin, @p n per direction, numbered i + n_0 (j +
+       * n_1 k); a sample belongs to the block of its midpoint (clamped to the tiling).
+       */
+      std::vector<double>
+      predicted_in_blocks(const dealii::Point<dim> &origin, double size, const std::array<int, dim> &n) const;
 
     private:
       std::function<double(const dealii::Point<dim> &)> function;
       std::string                                       expression, where;
+      /// The samples of sample(): midpoints lo + (i + 1/2) step, density / d^dim times
+      /// the sample's measure (0 outside the bodies), x fastest.
+      dealii::Point<dim>            sample_lo;
+      dealii::Tensor<1, dim>        sample_step;
+      std::array<unsigned int, dim> sample_n{};
+      std::vector<double>           sample_weight;
     };
 
     /**
