@@ -8,6 +8,7 @@ with one defect:
   inverted_hexahedron.msh      3D, 10 x 2 x 1 hexahedra; element 7 with its faces swapped (repaired)
   inverted_tetrahedron.msh     3D, each hexahedron as 6 tetrahedra; element 40 mirrored (repaired)
   bowtie_quadrilateral.msh     element 7 with two nodes swapped: a self-intersecting bow-tie
+  bowtie_binary.msh            the same in Gmsh's binary format 2.2
   coincident_nodes.msh         element 7's fourth node is a second node at its third node's point
   sliver.msh                   triangles; the square [0.4, 0.5] x [0, 0.05] as four, one of them
                                (element 9) 1e-12 m high
@@ -17,6 +18,7 @@ with one defect:
   truncated.msh                the file cut off in $Elements
 Run: python3 make_damaged_meshes.py (writes into this folder)."""
 import os
+import struct
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 NX, NY, L, H = 10, 2, 1.0, 0.1
@@ -32,6 +34,20 @@ def write(name, nodes, elements, before="", cut=None):
         lines = lines[:cut]
     with open(os.path.join(HERE, name), "w") as f:
         f.write("\n".join(lines) + "\n")
+
+
+def write_binary(name, nodes, elements):
+    """Gmsh 2.2 binary (little-endian int32 and float64, one block per element type)."""
+    data = b"$MeshFormat\n2.2 1 8\n" + struct.pack("<i", 1) + b"\n$EndMeshFormat\n"
+    data += b"$Nodes\n%d\n" % len(nodes)
+    data += b"".join(struct.pack("<i3d", k + 1, *map(float, p)) for k, p in enumerate(nodes))
+    data += b"\n$EndNodes\n$Elements\n%d\n" % len(elements)
+    kind = elements[0][0]
+    data += struct.pack("<3i", kind, len(elements), 2)
+    data += b"".join(struct.pack("<%di" % (3 + len(v)), k + 1, 1, 1, *v) for k, (_, v) in enumerate(elements))
+    data += b"\n$EndElements\n"
+    with open(os.path.join(HERE, name), "wb") as f:
+        f.write(data)
 
 
 def plane(xs):
@@ -61,6 +77,7 @@ elements = [(QUAD, q) for q in quads]
 a, b, c, d = elements[6][1]
 elements[6] = (QUAD, [a, b, d, c])
 write("bowtie_quadrilateral.msh", nodes, elements)
+write_binary("bowtie_binary.msh", nodes, elements)
 
 elements = [(QUAD, q) for q in quads]
 a, b, c, d = elements[6][1]
