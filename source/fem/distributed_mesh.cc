@@ -50,7 +50,7 @@ namespace hysteron
         }
       };
 
-      /// How a cell is named in messages: "(x, y), ..." after its element number or index.
+      /// The vertices of @p cell.
       template <int dim>
       std::vector<dealii::Point<dim>>
       points_of(const std::vector<dealii::Point<dim>> &vertices, const dealii::CellData<dim> &cell)

@@ -85,7 +85,17 @@ namespace hysteron
       // Quadrilaterals and hexahedra of a structured mesh: a small coarse mesh on every rank
       // (p4est) and global refinements. Everything else is made whole on rank 0, which keeps
       // only its part of it (parallel::fullydistributed).
-      if (kind != "structured" || generate_simplices || !make_structured_mesh(shapes))
+      bool made = false;
+      if (kind == "structured" && !generate_simplices)
+        {
+          made = make_structured_mesh(shapes);
+          if (!made)
+            scene.console() << "fem: the structured mesh has no coarse mesh of at most " << max_coarse_cells
+                            << " cells (odd cell counts, or bodies that are not rectangles/boxes): "
+                               "rank 0 makes it whole and distributes it"
+                            << std::endl;
+        }
+      if (!made)
         make_distributed_mesh(shapes, kind);
       set_mesh_box();
     }
