@@ -153,14 +153,21 @@ namespace hysteron
           prm.declare_entry("Refinements",
                             "0",
                             Patterns::Integer(0, 10),
-                            "Uniform refinements of the generated or read mesh (each halves h).");
+                            "Uniform refinements of the generated or read mesh (each halves h): "
+                            "by p4est on every rank for a structured mesh of quadrilaterals / "
+                            "hexahedra, on rank 0 before the mesh is partitioned for any other. "
+                            "A mesh that would not fit into the machine's memory is refused "
+                            "before it is made.");
           prm.declare_entry("Mesh file",
                             "",
                             Patterns::Anything(),
                             "Generator = file: a Gmsh .msh file (ASCII or binary, version 2 or "
                             "4) with quadrilaterals / triangles (2D) or hexahedra / tetrahedra "
                             "(3D), one kind per mesh; a relative name is "
-                            "looked up in the working directory, then beside the parameter file.");
+                            "looked up in the working directory, then beside the parameter file. "
+                            "Every cell's Jacobian is checked: inverted (clockwise) cells are "
+                            "repaired with a warning; self-intersecting and degenerate cells and "
+                            "coincident nodes are refused with the element (doc/fem.md).");
         }
         prm.leave_subsection();
 
