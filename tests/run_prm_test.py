@@ -21,6 +21,7 @@ The scene runs in a fresh working directory (relative output paths land there) w
   # FILES: <path>[, <path>]       input files the scene reads (paths relative to the .prm),
                                   copied into the working directory with the .prm
   # MPI: 2                        also run on 2 ranks; every output file must be identical
+                                  (with EXPECT-ERROR: the run must fail in the same way)
   # MPI-TOLERANCE: 1e-10[, 1e-14] with MPI: CSV values may differ by this fraction of the
                                   largest magnitude in their column (sums in another order),
                                   or by the optional absolute amount (columns of round-off)
@@ -161,6 +162,28 @@ def main():
                 and (expected_code == 1 or f.endswith(".tmp"))]
         if left:
             failures.append(f"output files left behind after a failed run: {left}")
+        # With MPI: N the run fails the same way on N ranks (rank 0's error reaches every rank).
+        for k, _, v in directives:
+            if k != "MPI":
+                continue
+            mpi_dir = args.workdir + f".np{v}"
+            shutil.rmtree(mpi_dir, ignore_errors=True)
+            os.makedirs(mpi_dir)
+            shutil.copy(prm, mpi_dir)
+            copy_inputs(mpi_dir)
+            mpi_command = [args.mpiexec, "-np", v] + command
+            code2, _, err2 = run(mpi_command, mpi_dir, env)
+            print("$ " + " ".join(mpi_command))
+            if code2 != expected_code:
+                failures.append(f"{v} ranks: exit status {code2}, expected {expected_code}: {err2[-2000:]}")
+            for regex in expect_error:
+                if not re.search(regex, err2):
+                    failures.append(f"{v} ranks: stderr does not match /{regex}/")
+            left = [f for f in output_files(mpi_dir)
+                    if f != os.path.basename(prm) and f not in inputs
+                    and (expected_code == 1 or f.endswith(".tmp"))]
+            if left:
+                failures.append(f"{v} ranks: output files left behind after a failed run: {left}")
     else:
         if code != 0:
             failures.append(f"exit status {code}")
@@ -211,7 +234,7 @@ def main():
                 parts = [float(x) for x in v.split(",")]
                 tolerance = (parts[0], parts[1] if len(parts) > 1 else 0.0)
         for k, _, v in directives:
-            if k != "MPI":
+            if k != "MPI" or expect_error:
                 continue
             ranks = int(v)
             mpi_dir = args.workdir + f".np{ranks}"

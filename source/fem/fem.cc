@@ -42,6 +42,67 @@ namespace hysteron
 
 
 
+    namespace
+    {
+      /// The entries of `FEM/Mesh`.
+      void
+      declare_mesh_parameters(dealii::ParameterHandler &prm)
+      {
+        using namespace dealii;
+        prm.declare_entry("Generator",
+                          "automatic",
+                          Patterns::Selection("automatic|structured|unstructured|file"),
+                          "structured: a tensor-product mesh with lines at every coordinate of "
+                          "the bodies' rectangles/boxes (exact for such bodies); unstructured "
+                          "(2D): a Delaunay triangulation of the bodies' boundaries, each "
+                          "triangle split into three quadrilaterals; file: a Gmsh .msh file of "
+                          "quadrilaterals/hexahedra or of triangles/tetrahedra (`Mesh file`), "
+                          "cells assigned to the body "
+                          "that contains their centre; automatic: structured if every body is "
+                          "made of rectangles/boxes, else unstructured (2D). See doc/fem.md.");
+        prm.declare_entry("Cell size",
+                          "0",
+                          Patterns::Double(),
+                          "Target cell size h [m] of the generated mesh, > 0 (not used with "
+                          "`file`).");
+        prm.declare_entry("Cell shape",
+                          "hypercube",
+                          Patterns::Selection("hypercube|simplex"),
+                          "hypercube: the generated mesh of quadrilaterals / hexahedra; simplex: "
+                          "each of its cells split into triangles (8 per quadrilateral) or "
+                          "tetrahedra (24 per hexahedron), with FE_SimplexP elements of the "
+                          "same `Degree`. A mesh file's cells decide by themselves "
+                          "(Generator = file reads quadrilaterals/hexahedra or "
+                          "triangles/tetrahedra). See doc/fem.md.");
+        prm.declare_entry("Curved boundary resolution",
+                          "0",
+                          Patterns::Double(),
+                          "unstructured: the segment length [m] of curved boundaries (disks "
+                          "become regular polygons with sides of about this length), >= 0; 0: "
+                          "half the cell size. The mesh is graded towards finer boundaries.");
+        prm.declare_entry("Refinements",
+                          "0",
+                          Patterns::Integer(0, 10),
+                          "Uniform refinements of the generated or read mesh (each halves h): "
+                          "by p4est on every rank for a structured mesh of quadrilaterals / "
+                          "hexahedra, on rank 0 before the mesh is partitioned for any other. "
+                          "A mesh that would not fit into the machine's memory is refused "
+                          "before it is made.");
+        prm.declare_entry("Mesh file",
+                          "",
+                          Patterns::Anything(),
+                          "Generator = file: a Gmsh .msh file (ASCII or binary, version 2 or "
+                          "4) with quadrilaterals / triangles (2D) or hexahedra / tetrahedra "
+                          "(3D), one kind per mesh; a relative name is "
+                          "looked up in the working directory, then beside the parameter file. "
+                          "Every cell's Jacobian is checked: inverted (clockwise) cells are "
+                          "repaired with a warning; self-intersecting and degenerate cells and "
+                          "coincident nodes are refused with the element (doc/fem.md).");
+      }
+    } // namespace
+
+
+
     template <int dim>
     void
     Solver<dim>::declare_parameters(dealii::ParameterHandler &prm)
@@ -118,50 +179,7 @@ namespace hysteron
                           "stress, von Mises stress, strain, material state), sorted by position.");
 
         prm.enter_subsection("Mesh");
-        {
-          prm.declare_entry("Generator",
-                            "automatic",
-                            Patterns::Selection("automatic|structured|unstructured|file"),
-                            "structured: a tensor-product mesh with lines at every coordinate of "
-                            "the bodies' rectangles/boxes (exact for such bodies); unstructured "
-                            "(2D): a Delaunay triangulation of the bodies' boundaries, each "
-                            "triangle split into three quadrilaterals; file: a Gmsh .msh file of "
-                            "quadrilaterals/hexahedra or of triangles/tetrahedra (`Mesh file`), "
-                            "cells assigned to the body "
-                            "that contains their centre; automatic: structured if every body is "
-                            "made of rectangles/boxes, else unstructured (2D). See doc/fem.md.");
-          prm.declare_entry("Cell size",
-                            "0",
-                            Patterns::Double(),
-                            "Target cell size h [m] of the generated mesh, > 0 (not used with "
-                            "`file`).");
-          prm.declare_entry("Cell shape",
-                            "hypercube",
-                            Patterns::Selection("hypercube|simplex"),
-                            "hypercube: the generated mesh of quadrilaterals / hexahedra; simplex: "
-                            "each of its cells split into triangles (8 per quadrilateral) or "
-                            "tetrahedra (24 per hexahedron), with FE_SimplexP elements of the "
-                            "same `Degree`. A mesh file's cells decide by themselves "
-                            "(Generator = file reads quadrilaterals/hexahedra or "
-                            "triangles/tetrahedra). See doc/fem.md.");
-          prm.declare_entry("Curved boundary resolution",
-                            "0",
-                            Patterns::Double(),
-                            "unstructured: the segment length [m] of curved boundaries (disks "
-                            "become regular polygons with sides of about this length), >= 0; 0: "
-                            "half the cell size. The mesh is graded towards finer boundaries.");
-          prm.declare_entry("Refinements",
-                            "0",
-                            Patterns::Integer(0, 10),
-                            "Uniform refinements of the generated or read mesh (each halves h).");
-          prm.declare_entry("Mesh file",
-                            "",
-                            Patterns::Anything(),
-                            "Generator = file: a Gmsh .msh file (ASCII or binary, version 2 or "
-                            "4) with quadrilaterals / triangles (2D) or hexahedra / tetrahedra "
-                            "(3D), one kind per mesh; a relative name is "
-                            "looked up in the working directory, then beside the parameter file.");
-        }
+        declare_mesh_parameters(prm);
         prm.leave_subsection();
 
         prm.enter_subsection("Newton");

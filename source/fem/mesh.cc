@@ -1,8 +1,9 @@
 // The FEM mesh of the scene's bodies, the DoFs and vectors, and the quadrature-point history.
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/utilities.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/base/quadrature_lib.h>
-#include <deal.II/distributed/shared_tria.h>
+#include <deal.II/distributed/tria.h>
 #include <deal.II/fe/fe_q.h>
 #include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/mapping_fe.h>
@@ -33,6 +34,23 @@ namespace hysteron
 {
   namespace FEM
   {
+    namespace
+    {
+      /// Coarse meshes of structured meshes stay below this many cells: p4est and deal.II
+      /// keep every coarse cell on every rank (a few MB).
+      constexpr double max_coarse_cells = 4096;
+
+      /// Structured meshes may round their counts up to coarsen if that adds at most 20 %
+      /// of cells; else they are made whole on rank 0 and distributed.
+      constexpr double max_growth = 1.2;
+
+      /// Bytes per cell of rank 0's serial triangulation (refined, partitioned, described)
+      /// while it makes the meshes of parallel::fullydistributed (measured, rounded up).
+      constexpr double serial_bytes_per_cell[2] = {1.5e3, 4e3};
+    } // namespace
+
+
+
     template <int dim>
     void
     Solver<dim>::make_mesh()
@@ -49,148 +67,171 @@ namespace hysteron
             mesh_to_body.push_back(b);
             shapes.push_back(&bodies[b].shape);
           }
+      cell_group.clear();
+      physical_names.clear();
 
-      if (generator == "file")
+      std::string kind = generator;
+      if (kind == "automatic")
         {
-          dealii::Triangulation<dim> serial;
-          dealii::GridIn<dim>        in;
-          in.attach_triangulation(serial);
-          try
-            {
-              in.read_msh(mesh_file);
-            }
-          catch (const dealii::ExceptionBase &e)
-            {
-              std::ostringstream m;
-              e.print_info(m);
-              throw InputError("FEM/Mesh/Mesh file", "cannot read '" + mesh_file + "': " + m.str());
-            }
-          read_physical_groups(serial);
-          const auto first_kind = serial.begin_active()->reference_cell();
-          for (const auto &cell : serial.active_cell_iterators())
-            {
-              const auto kind = cell->reference_cell();
-              require((kind == dealii::ReferenceCells::get_hypercube<dim>() ||
-                       kind == dealii::ReferenceCells::get_simplex<dim>()) &&
-                        kind == first_kind,
-                      "FEM/Mesh/Mesh file",
-                      "'" + mesh_file + "' has " + kind.to_string() + " and " + first_kind.to_string() +
-                        " cells; the fem method needs one kind: quadrilaterals or triangles "
-                        "(2D), hexahedra or tetrahedra (3D)");
-              const auto   centre = cell->center();
-              unsigned int body   = dealii::numbers::invalid_unsigned_int;
-              for (unsigned int m = 0; m < shapes.size() && body == dealii::numbers::invalid_unsigned_int; ++m)
-                if (shapes[m]->contains(centre, 1e-9 * cell->diameter()))
-                  body = m;
-              if (body == dealii::numbers::invalid_unsigned_int)
-                {
-                  std::ostringstream p;
-                  p << centre;
-                  throw InputError("FEM/Mesh/Mesh file",
-                                   "the cell with centre (" + p.str() + ") of '" + mesh_file +
-                                     "' lies in no body's Shape");
-                }
-              cell->set_material_id(body);
-            }
-          distribute_mesh(serial);
-          check_coarse_order(serial);
+          bool rectilinear = true;
+          for (const auto *shape : shapes)
+            rectilinear = rectilinear && Geometry::is_rectilinear(*shape);
+          require(rectilinear || dim == 2,
+                  "FEM/Mesh/Generator",
+                  "in 3D only bodies made of boxes are meshed automatically; give a Gmsh "
+                  "file (Generator = file)");
+          kind = rectilinear ? "structured" : "unstructured";
         }
+      // Quadrilaterals and hexahedra of a structured mesh: a small coarse mesh on every rank
+      // (p4est) and global refinements. Everything else is made whole on rank 0, which keeps
+      // only its part of it (parallel::fullydistributed).
+      bool made = false;
+      if (kind == "structured" && !generate_simplices)
+        {
+          made = make_structured_mesh(shapes);
+          if (!made)
+            scene.console() << "fem: the structured mesh has no coarse mesh of at most " << max_coarse_cells
+                            << " cells (odd cell counts, or bodies that are not rectangles/boxes): "
+                               "rank 0 makes it whole and distributes it"
+                            << std::endl;
+        }
+      if (!made)
+        make_distributed_mesh(shapes, kind);
+      set_mesh_box();
+    }
+
+
+
+    template <int dim>
+    Geometry::CoarseMesh<dim>
+    Solver<dim>::generated_mesh(const std::vector<const Geometry::Region<dim> *> &shapes,
+                                const std::string                                &kind) const
+    {
+      Geometry::CoarseMesh<dim> mesh;
+      if constexpr (dim == 2)
+        mesh = kind == "structured" ?
+                 Geometry::structured_mesh<dim>(shapes, cell_size, "FEM/Mesh/Cell size") :
+                 // The generator's size bound is that of its triangles; each is split
+                 // into three quadrilaterals with edges of at most half of it.
+                 Geometry::unstructured_mesh(shapes, 2 * cell_size, "FEM/Mesh/Cell size",
+                                             boundary_resolution > 0 ? boundary_resolution :
+                                                                       0.5 * cell_size);
       else
-        {
-          std::string kind = generator;
-          if (kind == "automatic")
-            {
-              bool rectilinear = true;
-              for (const auto *shape : shapes)
-                rectilinear = rectilinear && Geometry::is_rectilinear(*shape);
-              require(rectilinear || dim == 2,
-                      "FEM/Mesh/Generator",
-                      "in 3D only bodies made of boxes are meshed automatically; give a Gmsh "
-                      "file (Generator = file)");
-              kind = rectilinear ? "structured" : "unstructured";
-            }
-          Geometry::CoarseMesh<dim> mesh;
-          if constexpr (dim == 2)
-            mesh = kind == "structured" ?
-                     Geometry::structured_mesh<dim>(shapes, cell_size, "FEM/Mesh/Cell size") :
-                     // The generator's size bound is that of its triangles; each is split
-                     // into three quadrilaterals with edges of at most half of it.
-                     Geometry::unstructured_mesh(shapes, 2 * cell_size, "FEM/Mesh/Cell size",
-                                                 boundary_resolution > 0 ? boundary_resolution :
-                                                                           0.5 * cell_size);
-          else
-            mesh = Geometry::structured_mesh<dim>(shapes, cell_size, "FEM/Mesh/Cell size");
-          if (kind == "structured")
-            {
-              // A staircase approximation of a curved or oblique body is refused.
-              double body_volume = 0;
-              for (const auto *shape : shapes)
-                body_volume += shape->volume_estimate();
-              const double mismatch = std::abs(mesh.volume() - body_volume) / body_volume;
-              require(mismatch < 2e-3,
-                      "FEM/Mesh/Generator",
-                      "the structured mesh misses " + std::to_string(100 * mismatch) +
-                        " % of the bodies' volume (a body is not made of rectangles/boxes): "
-                        "use Generator = unstructured (2D) or a Gmsh file");
-            }
-          if (generate_simplices)
-            {
-              // Each quadrilateral into 8 triangles, each hexahedron into 24 tetrahedra
-              // (material ids kept).
-              dealii::Triangulation<dim> hypercubes, simplices;
-              hypercubes.create_triangulation(mesh.vertices, mesh.cells, dealii::SubCellData());
-              dealii::GridGenerator::convert_hypercube_to_simplex_mesh(hypercubes, simplices);
-              distribute_mesh(simplices);
-            }
-          else
-            {
-              triangulation = std::make_unique<dealii::parallel::distributed::Triangulation<dim>>(
-                this->get_scene().mpi_communicator());
-              triangulation->create_triangulation(mesh.vertices, mesh.cells, dealii::SubCellData());
-            }
-        }
-      if (refinements > 0)
-        {
-          // Each refinement multiplies the cells by 2^dim: refuse a mesh that cannot fit in
-          // this machine's memory before making it (it would end in std::bad_alloc after
-          // minutes). About 2 kB per quadrature point (history, tangent, matrix rows).
-          const double cells = triangulation->n_global_active_cells() *
-                               std::pow(2.0, dim * static_cast<double>(refinements));
-          const double per_rank =
-            cells / dealii::Utilities::MPI::n_mpi_processes(this->get_scene().mpi_communicator());
-          const double bytes  = per_rank * std::pow(degree + 1.0, dim) * 2e3;
-          const double memory = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * sysconf(_SC_PAGE_SIZE);
-          if (bytes > memory)
-            {
-              std::ostringstream m;
-              m << "refining the mesh of " << triangulation->n_global_active_cells() << " cells "
-                << refinements << " times gives " << cells << " cells (" << per_rank
-                << " per MPI rank), about " << bytes / (1u << 30) << " GiB per rank with Q" << degree
-                << "; this machine has " << memory / (1u << 30)
-                << " GiB: use fewer refinements, a coarser FEM/Mesh/Cell size or more ranks";
-              throw InputError("FEM/Mesh/Refinements", m.str());
-            }
-          triangulation->refine_global(refinements);
-        }
+        mesh = Geometry::structured_mesh<dim>(shapes, cell_size, "FEM/Mesh/Cell size");
+      if (kind == "structured")
+        check_staircase(shapes, mesh.volume());
+      return mesh;
+    }
 
+
+
+    template <int dim>
+    void
+    Solver<dim>::check_staircase(const std::vector<const Geometry::Region<dim> *> &shapes,
+                                 const double                                      volume) const
+    {
+      // A staircase approximation of a curved or oblique body is refused.
+      double body_volume = 0;
+      for (const auto *shape : shapes)
+        body_volume += shape->volume_estimate();
+      const double mismatch = std::abs(volume - body_volume) / body_volume;
+      require(mismatch < 2e-3,
+              "FEM/Mesh/Generator",
+              "the structured mesh misses " + std::to_string(100 * mismatch) +
+                " % of the bodies' volume (a body is not made of rectangles/boxes): "
+                "use Generator = unstructured (2D) or a Gmsh file");
+    }
+
+
+
+    template <int dim>
+    bool
+    Solver<dim>::make_structured_mesh(const std::vector<const Geometry::Region<dim> *> &shapes)
+    {
+      auto structured = Geometry::coarse_structured_mesh<dim>(shapes, cell_size, "FEM/Mesh/Cell size",
+                                                              max_coarse_cells, max_growth);
+      if (structured.coarse.cells.empty())
+        return false;
+      check_staircase(shapes, structured.coarse.volume());
+      auto &mesh = structured.coarse;
+      AssertThrow(Geometry::check_cells(mesh.vertices, mesh.cells).valid, dealii::ExcInternalError());
+      if (!structured.note.empty())
+        this->get_scene().console() << "fem: " << structured.note << std::endl;
+      simplex = false;
+      check_memory(mesh.cells.size(), structured.levels, false);
+      triangulation = std::make_unique<dealii::parallel::distributed::Triangulation<dim>>(
+        this->get_scene().mpi_communicator());
+      triangulation->create_triangulation(mesh.vertices, mesh.cells, dealii::SubCellData());
+      triangulation->refine_global(structured.levels + refinements);
+      return true;
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::check_memory(const double coarse_cells, const unsigned int levels, const bool serial) const
+    {
+      // Each refinement multiplies the cells by 2^dim: refuse a mesh that cannot fit in this
+      // machine's memory before making it (it would end in std::bad_alloc after minutes).
+      // About 2 kB per quadrature point (history, tangent, matrix rows) on each rank for its
+      // share of the cells, the ranks of one machine together, and on rank 0 during the
+      // set-up of a mesh it makes whole (serial) the serial triangulation.
+      const MPI_Comm     comm  = this->get_scene().mpi_communicator();
+      const unsigned int rank  = dealii::Utilities::MPI::this_mpi_process(comm);
+      const double       given = coarse_cells * std::pow(2.0, dim * static_cast<double>(levels));
+      const double       cells = given * std::pow(2.0, dim * static_cast<double>(refinements));
+      const double per_rank = cells / dealii::Utilities::MPI::n_mpi_processes(comm) * std::pow(degree + 1.0, dim) * 2e3;
+      const double on_root  = serial ? cells * serial_bytes_per_cell[dim - 2] : 0.0;
+      MPI_Comm     node;
+      MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node);
+      const unsigned int on_node   = dealii::Utilities::MPI::n_mpi_processes(node);
+      const bool         root_here = dealii::Utilities::MPI::logical_or(rank == 0, node);
+      MPI_Comm_free(&node);
+      const double memory = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * sysconf(_SC_PAGE_SIZE);
+      const double need   = on_node * per_rank + (root_here ? on_root : 0.0);
+      if (dealii::Utilities::MPI::max(need / memory, comm) <= 1)
+        return;
+      std::ostringstream m;
+      constexpr double   GiB = 1u << 30;
+      if (refinements > 0)
+        m << "refining the mesh of " << given << " cells " << refinements << " times gives " << cells << " cells";
+      else
+        m << "the mesh has " << cells << " cells";
+      m << " (" << cells / dealii::Utilities::MPI::n_mpi_processes(comm) << " per MPI rank), about "
+        << per_rank / GiB << " GiB per rank with " << (simplex ? "P" : "Q") << degree;
+      if (serial)
+        m << " and " << on_root / GiB << " GiB more on rank 0 while it makes and partitions the whole mesh";
+      m << "; this machine has " << memory / GiB << " GiB for " << on_node
+        << " ranks: use fewer refinements, a coarser FEM/Mesh/Cell size or more machines";
+      throw InputError(refinements > 0 ? "FEM/Mesh/Refinements" :
+                       generator == "file" ? "FEM/Mesh/Mesh file" :
+                                             "FEM/Mesh/Cell size",
+                       m.str());
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::set_mesh_box()
+    {
+      const Scene<dim> &scene = this->get_scene();
       // The bounding box of the mesh (faces of boundary conditions) and its scale.
-      std::vector<dealii::Point<dim>> corners;
-      for (const auto &cell : triangulation->active_cell_iterators())
-        if (cell->is_locally_owned())
-          for (const unsigned int v : cell->vertex_indices())
-            corners.push_back(cell->vertex(v));
       dealii::Point<dim> lo, hi;
       for (unsigned int d = 0; d < dim; ++d)
         {
           lo[d] = std::numeric_limits<double>::max();
           hi[d] = -std::numeric_limits<double>::max();
         }
-      for (const auto &p : corners)
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            lo[d] = std::min(lo[d], p[d]);
-            hi[d] = std::max(hi[d], p[d]);
-          }
+      for (const auto &cell : triangulation->active_cell_iterators())
+        if (cell->is_locally_owned())
+          for (const unsigned int v : cell->vertex_indices())
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                lo[d] = std::min(lo[d], cell->vertex(v)[d]);
+                hi[d] = std::max(hi[d], cell->vertex(v)[d]);
+              }
       for (unsigned int d = 0; d < dim; ++d)
         {
           lo[d] = dealii::Utilities::MPI::min(lo[d], scene.mpi_communicator());
@@ -223,30 +264,9 @@ namespace hysteron
                       "and Faces = x- (u_r = 0 on the axis)");
             }
         }
-      u_scale  = 0;
+      u_scale = 0;
       for (unsigned int d = 0; d < dim; ++d)
         u_scale = std::max(u_scale, hi[d] - lo[d]);
-    }
-
-
-
-    template <int dim>
-    void
-    Solver<dim>::distribute_mesh(const dealii::Triangulation<dim> &serial)
-    {
-      // p4est has no simplices: a mesh of them is shared by the ranks (every rank keeps the
-      // coarse mesh, METIS gives each its cells), which serves meshes up to a few million cells.
-      MPI_Comm comm = this->get_scene().mpi_communicator();
-      simplex       = serial.begin_active()->reference_cell() == dealii::ReferenceCells::get_simplex<dim>();
-      if (simplex)
-        triangulation = std::make_unique<dealii::parallel::shared::Triangulation<dim>>(
-          comm,
-          dealii::Triangulation<dim>::none,
-          false,
-          dealii::parallel::shared::Triangulation<dim>::partition_metis);
-      else
-        triangulation = std::make_unique<dealii::parallel::distributed::Triangulation<dim>>(comm);
-      triangulation->copy_triangulation(serial);
     }
 
 
@@ -388,11 +408,7 @@ namespace hysteron
 
 
 
-    template void Solver<2>::make_mesh();
-    template void Solver<3>::make_mesh();
-    template void Solver<2>::setup_system();
-    template void Solver<3>::setup_system();
-    template void Solver<2>::setup_history();
-    template void Solver<3>::setup_history();
+    template class Solver<2>;
+    template class Solver<3>;
   } // namespace FEM
 } // namespace hysteron

@@ -7,79 +7,11 @@
 #include <hysteron/fem/fem.h>
 
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 
 namespace hysteron
 {
   namespace FEM
   {
-    namespace
-    {
-      /// The $PhysicalNames section of a Gmsh file (versions 2 and 4, ASCII or binary: the
-      /// section is text in both): name -> (dimension, tag). It precedes the nodes.
-      std::map<std::string, std::pair<unsigned int, unsigned int>>
-      read_physical_names(const std::string &file)
-      {
-        std::map<std::string, std::pair<unsigned int, unsigned int>> names;
-        std::ifstream in(file, std::ios::binary);
-        std::string   line;
-        while (std::getline(in, line))
-          {
-            line = dealii::Utilities::trim(line);
-            if (line == "$Nodes" || line == "$Entities")
-              break;
-            if (line != "$PhysicalNames")
-              continue;
-            unsigned int n = 0;
-            if (!std::getline(in, line) || !(std::istringstream(line) >> n))
-              throw InputError("FEM/Mesh/Mesh file", "'" + file + "': $PhysicalNames has no count");
-            for (unsigned int k = 0; k < n && std::getline(in, line); ++k)
-              {
-                std::istringstream row(line);
-                unsigned int       dim = 0, tag = 0;
-                const auto         open = line.find('"'), close = line.rfind('"');
-                if (!(row >> dim >> tag) || open == std::string::npos || close <= open)
-                  throw InputError("FEM/Mesh/Mesh file",
-                                   "'" + file + "': cannot read the physical name '" + line + "'");
-                names[line.substr(open + 1, close - open - 1)] = {dim, tag};
-              }
-            break;
-          }
-        return names;
-      }
-    } // namespace
-
-
-
-    template <int dim>
-    void
-    Solver<dim>::read_physical_groups(const dealii::Triangulation<dim> &serial)
-    {
-      // Gmsh's physical tags arrive as the cells' material ids and the boundary faces'
-      // boundary ids (a face or cell in several groups keeps the last one).
-      coarse_group.clear();
-      for (const auto &cell : serial.active_cell_iterators())
-        coarse_group.push_back(cell->material_id());
-      physical_names = read_physical_names(mesh_file);
-    }
-
-
-
-    template <int dim>
-    void
-    Solver<dim>::check_coarse_order(const dealii::Triangulation<dim> &serial) const
-    {
-      AssertThrow(triangulation->n_cells(0) == serial.n_cells(0), dealii::ExcInternalError());
-      auto copy = triangulation->begin(0);
-      for (auto cell = serial.begin(0); cell != serial.end(0); ++cell, ++copy)
-        AssertThrow(copy->index() == cell->index() &&
-                      copy->center().distance(cell->center()) <= 1e-12 * cell->diameter(),
-                    dealii::ExcMessage("the distributed mesh reordered the coarse cells of the mesh file"));
-    }
-
-
-
     template <int dim>
     typename Solver<dim>::PhysicalGroup
     Solver<dim>::physical_group(const std::string &group, const std::string &where) const
@@ -154,19 +86,6 @@ namespace hysteron
               "name the group in Gmsh and give its name");
       result.faces = as_faces;
       return result;
-    }
-
-
-
-    template <int dim>
-    bool
-    Solver<dim>::in_cell_group(const typename dealii::Triangulation<dim>::cell_iterator &cell,
-                               const unsigned int                                       tag) const
-    {
-      typename dealii::Triangulation<dim>::cell_iterator coarse = cell;
-      while (coarse->level() > 0)
-        coarse = coarse->parent();
-      return coarse_group[coarse->index()] == tag;
     }
 
 

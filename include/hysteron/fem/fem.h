@@ -17,6 +17,7 @@
 #include <hysteron/base/implicit_dynamics.h>
 #include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>
+#include <hysteron/geometry/mesh.h>
 #include <hysteron/geometry/region.h>
 #include <hysteron/scene/method.h>
 #include <hysteron/scene/point_data.h>
@@ -252,8 +253,38 @@ namespace hysteron
       bool          quadrature_table = false;
 
       // Set-up.
+      /// The mesh of the deformable bodies (mesh.cc): a structured mesh as a coarse mesh on
+      /// every rank and global refinements (p4est), any other mesh made whole on rank 0 and
+      /// distributed (make_distributed_mesh()); then set_mesh_box().
       void
       make_mesh();
+      /// A structured mesh of quadrilaterals / hexahedra as a parallel::distributed
+      /// triangulation; false (nothing made) if it cannot be coarsened enough
+      /// (Geometry::coarse_structured_mesh()).
+      bool
+      make_structured_mesh(const std::vector<const Geometry::Region<dim> *> &shapes);
+      /// The whole structured or unstructured mesh of @p shapes (@p kind), on rank 0.
+      Geometry::CoarseMesh<dim>
+      generated_mesh(const std::vector<const Geometry::Region<dim> *> &shapes, const std::string &kind) const;
+      /// Refuse a structured mesh of @p volume that misses part of the bodies' volume.
+      void
+      check_staircase(const std::vector<const Geometry::Region<dim> *> &shapes, const double volume) const;
+      /**
+       * Rank 0 reads (Gmsh) or generates the mesh of kind @p kind, checks its cells, assigns
+       * bodies, splits it into simplices (Cell shape), refines, partitions and describes it;
+       * each rank keeps its cells and their neighbours (parallel::fullydistributed). Errors
+       * of rank 0 are thrown on every rank (distributed_mesh.cc).
+       */
+      void
+      make_distributed_mesh(const std::vector<const Geometry::Region<dim> *> &shapes, const std::string &kind);
+      /// Refuse a mesh of @p coarse_cells cells, refined @p levels + `Refinements` times,
+      /// that does not fit into the machine's memory (@p serial: rank 0 holds it whole
+      /// while it sets it up).
+      void
+      check_memory(const double coarse_cells, const unsigned int levels, const bool serial) const;
+      /// The mesh's bounding box, the length scale and the checks of an axisymmetric mesh.
+      void
+      set_mesh_box();
       void
       setup_system();
       void
@@ -271,18 +302,6 @@ namespace hysteron
       setup_dynamics();
 
       // Named sets (sets.cc): Gmsh physical groups and the `History sets` tables.
-      /// Move the coarse mesh @p serial into the parallel triangulation (p4est for hypercubes,
-      /// shared for simplices; refused if it mixes the two).
-      void
-      distribute_mesh(const dealii::Triangulation<dim> &serial);
-      /// Generator = file: the physical tags of the cells of @p serial (before make_mesh()
-      /// sets their bodies) and the group names of the mesh file.
-      void
-      read_physical_groups(const dealii::Triangulation<dim> &serial);
-      /// After the mesh is copied into the distributed triangulation: its coarse cells must be
-      /// those of @p serial in the same order (the groups are stored by coarse cell).
-      void
-      check_coarse_order(const dealii::Triangulation<dim> &serial) const;
       /// A physical group of the mesh file: boundary faces or cells with this tag.
       struct PhysicalGroup
       {
@@ -293,9 +312,13 @@ namespace hysteron
       /// mesh file has it.
       PhysicalGroup
       physical_group(const std::string &group, const std::string &where) const;
-      /// Whether @p cell (at any level) lies in cell group @p tag.
+      /// Whether the (locally owned or ghost) @p cell lies in cell group @p tag.
+      template <typename Iterator>
       bool
-      in_cell_group(const typename dealii::Triangulation<dim>::cell_iterator &cell, const unsigned int tag) const;
+      in_cell_group(const Iterator &cell, const unsigned int tag) const
+      {
+        return !cell_group.empty() && cell_group[cell->active_cell_index()] == tag;
+      }
       /// The locally relevant DoFs of @p group (nodes of its faces or cells), with their components.
       std::vector<std::pair<dealii::types::global_dof_index, unsigned int>>
       group_dofs(const PhysicalGroup &group) const;
@@ -426,8 +449,9 @@ namespace hysteron
       std::vector<dealii::Tensor<1, dim>>
       reactions() const;
 
-      // The discretisation: quadrilaterals / hexahedra on a p4est triangulation, or
-      // triangles / tetrahedra (FE_SimplexP, Gauss-simplex rules) on a shared one.
+      // The discretisation: quadrilaterals / hexahedra or triangles / tetrahedra (FE_SimplexP,
+      // Gauss-simplex rules) on a p4est triangulation (structured meshes) or a fully
+      // distributed one (every other mesh).
       std::unique_ptr<dealii::parallel::TriangulationBase<dim>> triangulation;
       bool                                               simplex = false;
       std::unique_ptr<dealii::FESystem<dim>>            fe;
@@ -445,9 +469,9 @@ namespace hysteron
       std::vector<const Material::Interface<dim> *> body_material;
       std::vector<unsigned int>                     body_to_mesh; ///< scene body -> material id
       std::vector<unsigned int>                     mesh_to_body;
-      /// Generator = file: the physical tag of every coarse cell, and the named groups
-      /// ($PhysicalNames: name -> dimension, tag).
-      std::vector<unsigned int>                                   coarse_group;
+      /// Generator = file: the physical tag of every locally owned and ghost cell (by active
+      /// cell index), and the named groups ($PhysicalNames: name -> dimension, tag).
+      std::vector<unsigned int>                                   cell_group;
       std::map<std::string, std::pair<unsigned int, unsigned int>> physical_names;
       /// `History sets`: the owned DoFs of each set, their components and the weight 1 / n_c
       /// of the mean over the set's nodes of each component.

@@ -79,6 +79,87 @@ namespace hysteron
                     const std::string                       &where);
 
     /**
+     * A structured_mesh() as a coarse mesh that `levels` global refinements (bisection of
+     * every cell) turn into the mesh, so that a distributed triangulation (p4est) needs
+     * to replicate only the coarse cells on every rank.
+     */
+    template <int dim>
+    struct StructuredMesh
+    {
+      CoarseMesh<dim> coarse;     ///< empty if the mesh cannot be coarsened (see below)
+      unsigned int    levels = 0; ///< global refinements of `coarse`
+      double          n_cells = 0; ///< cells after the refinements
+      std::string     note;        ///< how the counts were changed, for the log (or empty)
+    };
+
+    /**
+     * The cells of structured_mesh() with the same breakpoints, built from a coarse mesh
+     * of at most @p max_coarse_cells cells (counted in the tensor grid):
+     *
+     * 1. exact: L is the smallest level that gives at most @p max_coarse_cells coarse cells
+     *    with every interval's count n a multiple of 2^L; the coarse mesh has n / 2^L cells per
+     *    interval and L refinements give structured_mesh()'s cells (vertex positions to
+     *    round-off: refinement bisects). A mesh of at most @p max_coarse_cells cells is its own
+     *    coarse mesh (L = 0);
+     * 2. otherwise, rounded: the smallest L > 0 for which counts rounded up to multiples
+     *    of 2^L give a small enough coarse mesh, if that adds at most a fraction
+     *    @p max_growth - 1 of cells (the cells of some intervals shrink; `note` says by how
+     *    much);
+     * 3. otherwise (or if a body is not rectilinear, where the coarse cells' centres would
+     *    assign other staircase cells to the bodies), `coarse` is empty: the caller builds
+     *    structured_mesh() and distributes it as an unstructured mesh.
+     *
+     * InputError(@p where, ...) as structured_mesh(); the coarse tensor grid obeys its
+     * 5e6-cell limit, the refined mesh only an overflow bound (1e12 cells).
+     */
+    template <int dim>
+    StructuredMesh<dim>
+    coarse_structured_mesh(const std::vector<const Region<dim> *> &bodies,
+                           const double                             h,
+                           const std::string                       &where,
+                           const double                             max_coarse_cells,
+                           const double                             max_growth);
+
+    /// What check_cells() found.
+    struct CellCheck
+    {
+      bool         valid    = false; ///< every cell can carry finite elements (after repairs)
+      std::size_t  inverted = 0;     ///< cells that were inverted and are repaired
+      unsigned int cell     = 0;     ///< if not valid: the index of the first bad cell
+      std::string  problem;          ///< if not valid: what is wrong with it
+    };
+
+    /**
+     * What is wrong with the cell of vertices @p x (deal.II's order: a triangle or
+     * tetrahedron, or a quadrilateral or hexahedron numbered lexicographically), or "" if
+     * it can carry finite elements; @p inverted tells whether it is merely inverted
+     * (negative Jacobian everywhere: mirrored, clockwise in 2D), which a reordering of its
+     * vertices repairs. The checks, in this order: two vertices closer than 1e-12 of the
+     * diameter (coincident nodes); a Jacobian whose scaled determinant det J / prod |J e_d|
+     * takes both signs beyond 1e-6 at the vertices and at the 2- and 3-point Gauss points
+     * (a bow-tie or a non-convex cell); a measure below 1e-8 diameter^dim (a sliver); a
+     * scaled determinant within 1e-6 of zero (a flat corner).
+     */
+    template <int dim>
+    std::string
+    cell_defect(const std::vector<dealii::Point<dim>> &x, bool &inverted);
+
+    /**
+     * Check every cell with cell_defect(); if none is defective, repair the inverted ones
+     * (dealii::GridTools::invert_cells_with_negative_measure(), then
+     * consistently_order_cells() for quadrilaterals and hexahedra) and check them again.
+     * @p cells is changed only by the repair.
+     */
+    template <int dim>
+    CellCheck
+    check_cells(const std::vector<dealii::Point<dim>> &vertices, std::vector<dealii::CellData<dim>> &cells);
+
+    /// The vertices of @p cell as "(x, y), ...", around the cell as Gmsh lists them.
+    template <int dim>
+    std::string
+    vertex_list(const std::vector<dealii::Point<dim>> &vertices, const dealii::CellData<dim> &cell);
+
+    /**
      * 2D only: an unstructured, body-fitted quadrilateral mesh.
      *
      * 1. The boundaries of all primitives of all bodies (rectangle sides, polygon
