@@ -1,7 +1,18 @@
-// The FEM's part of a checkpoint: this rank's DoF values of the state vectors and
-// the converged quadrature-point history of its cells (in the order of the cells,
-// which the same mesh on the same ranks reproduces), and the sums a step carries over.
+// The FEM's part of a checkpoint, readable on any number of ranks:
+//  - one record per active cell, keyed by its CellId (the same on any number of ranks:
+//    the mesh is built anew from the scene), with the cell's values of every state
+//    vector and its converged quadrature-point history (CellHistory::serialize);
+//  - the global state (step control, counters, tables), and each rank's partial sums
+//    (the works, the walls' forces).
+// A resumed run puts each owned cell's values back into the owned entries of the
+// vectors (every owned DoF lies in an owned cell, and the cells that share it hold
+// the same value), so the state is the checkpoint's bit for bit on any partition; on
+// another number of ranks the partial sums are gathered on rank 0.
 #include <hysteron/fem/fem.h>
+
+#include "run/keyed_records.h"
+
+#include <sstream>
 
 namespace hysteron
 {
@@ -9,123 +20,161 @@ namespace hysteron
   {
     namespace
     {
-      template <typename VectorType>
-      void
-      put_owned(CheckpointWriter &out, const VectorType &v, const dealii::IndexSet &owned)
+      /**
+       * A key of an active cell that is the same on any number of ranks and dense:
+       * coarse cell c at refinement level L with child indices i_1 ... i_L is
+       * c 2^(dim L) + sum_k i_k 2^(dim (L - k)) (every active cell is on level L: the
+       * mesh is refined globally).
+       */
+      std::uint64_t
+      cell_key(const dealii::CellId &id, const unsigned int dim, const unsigned int level)
       {
-        std::vector<double> values;
-        values.reserve(owned.n_elements());
-        for (const auto i : owned)
-          values.push_back(v(i));
-        out.put(values);
-      }
-
-      template <typename VectorType>
-      void
-      get_owned(CheckpointReader &in, VectorType &v, const dealii::IndexSet &owned)
-      {
-        std::vector<double> values;
-        in.get(values);
-        if (values.size() != owned.n_elements())
-          in.refuse("the mesh has another number of DoFs on this rank than the checkpoint");
-        std::size_t k = 0;
-        for (const auto i : owned)
-          v(i) = values[k++];
-        v.compress(dealii::VectorOperation::insert);
+        std::uint64_t key = id.get_coarse_cell_id();
+        for (const auto child : id.get_child_indices())
+          key = (key << dim) | child;
+        return key << (dim * (level - id.get_child_indices().size()));
       }
     } // namespace
 
+
+
     template <int dim>
+    template <class Archive>
     void
-    Solver<dim>::save(CheckpointWriter &, CheckpointWriter &out, const CheckpointDirectory &) const
+    Solver<dim>::serialize_global(Archive &ar)
     {
-      out.section("fem vectors");
-      out.put<std::uint64_t>(dof_handler.n_dofs());
-      for (const Vector *vector : {&u, &v, &a, &u_trial, &f_int, &f_ext, &f_int_old, &f_ext_old,
-                              &inertia, &reaction_old})
-        put_owned(out, *vector, owned_dofs);
-      out.section("fem history");
-      for (const auto &cell : triangulation->active_cell_iterators())
-        if (cell->is_locally_owned())
-          {
-            const CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
-            out.put(h.stress);
-            out.put(h.strain);
-            out.put(h.state);
-            out.put(h.volume);
-            // The tangent of the converged state: the predictor of the next step uses it.
-            out.put(h.tangent);
-          }
-      out.section("fem sums");
-      out.put(internal_work);
-      out.put(external_work);
-      out.put(boundary_work);
-      out.put(force_scale);
-      out.put(last_force_level);
-      out.put(predictor_level);
-      out.put(current_dt);
-      out.put(initial_kinetic);
-      out.put(wall_forces);
-      out.put(n_newton);
-      out.put(n_cuts);
-      out.put(n_linear);
-      out.put(increments.state());
-      out.put(step_checked);
-      const_cast<PointData::Tables<dim> &>(tables).serialize(out);
+      ar.section("fem");
+      auto increment_state = increments.state();
+      ar &force_scale &last_force_level &predictor_level &current_dt &initial_kinetic &n_newton &n_cuts &n_linear
+        &increment_state &step_checked;
+      if constexpr (Archive::is_loading)
+        increments.restore(increment_state);
+      tables.serialize(ar);
+    }
+
+
+
+    template <int dim>
+    template <class Archive>
+    void
+    Solver<dim>::serialize_rank(Archive &ar)
+    {
+      ar.section("fem rank");
+      ar &internal_work &external_work &boundary_work &wall_forces;
     }
 
 
 
     template <int dim>
     void
-    Solver<dim>::load(CheckpointReader &, std::vector<CheckpointReader> &parts, const CheckpointDirectory &directory)
+    Solver<dim>::save(CheckpointWriter &global, CheckpointWriter &rank, const CheckpointDirectory &directory) const
     {
-      if (!directory.same_ranks())
-        throw InputError("--resume",
-                         "the fem method resumes on as many MPI ranks as wrote the checkpoint (" +
-                           std::to_string(directory.saved_ranks) + ")");
-      CheckpointReader &in = parts[0];
-      in.section("fem vectors");
-      if (in.get<std::uint64_t>() != dof_handler.n_dofs())
-        in.refuse("the mesh has another number of DoFs than the checkpoint's");
-      for (Vector *vector : {&u, &v, &a, &u_trial, &f_int, &f_ext, &f_int_old, &f_ext_old, &inertia,
-                        &reaction_old})
-        get_owned(in, *vector, owned_dofs);
+      auto &self = const_cast<Solver<dim> &>(*this); // serialize() only reads when saving
+      self.serialize_global(global);
+      self.serialize_rank(rank);
+
+      // The cells' values of the vectors need their ghost entries.
+      MPI_Comm                           comm = this->get_scene().mpi_communicator();
+      std::vector<dealii::TrilinosWrappers::MPI::Vector> ghosted;
+      for (Vector *x : self.state_vectors())
+        {
+          ghosted.emplace_back(owned_dofs, relevant_dofs, comm);
+          ghosted.back() = *x;
+        }
+      const unsigned int level = triangulation->n_global_levels() - 1;
+      std::vector<std::pair<std::uint64_t, std::string>> records;
+      std::vector<dealii::types::global_dof_index>       dofs(fe->n_dofs_per_cell());
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            std::ostringstream bytes;
+            CheckpointWriter   out(bytes);
+            cell->get_dof_indices(dofs);
+            for (const auto &x : ghosted)
+              for (const auto i : dofs)
+                out.put(x(i));
+            out & *cell_history[cell->active_cell_index()];
+            records.emplace_back(cell_key(cell->id(), dim, level), bytes.str());
+          }
+      const std::uint64_t n_keys = std::uint64_t(triangulation->n_global_coarse_cells()) << (dim * level);
+      Run::write_records(directory.file("cells"), n_keys, records, comm);
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::load(CheckpointReader              &global,
+                      std::vector<CheckpointReader> &rank_parts,
+                      const CheckpointDirectory     &directory)
+    {
+      serialize_global(global);
+      if (directory.same_ranks())
+        serialize_rank(rank_parts[0]);
+      else
+        {
+          // Another number of ranks: rank 0 carries the sums of all the ranks' parts.
+          const bool root  = this->get_scene().is_root();
+          double     sums[3] = {0, 0, 0};
+          auto       walls   = wall_forces;
+          for (auto &w : walls)
+            w = 0;
+          for (auto &part : rank_parts)
+            {
+              serialize_rank(part);
+              sums[0] += internal_work;
+              sums[1] += external_work;
+              sums[2] += boundary_work;
+              for (std::size_t i = 0; i < walls.size() && i < wall_forces.size(); ++i)
+                walls[i] += wall_forces[i];
+            }
+          internal_work = root ? sums[0] : 0.0;
+          external_work = root ? sums[1] : 0.0;
+          boundary_work = root ? sums[2] : 0.0;
+          wall_forces   = walls;
+          if (!root)
+            for (auto &w : wall_forces)
+              w = 0;
+        }
+
+      const unsigned int                   level = triangulation->n_global_levels() - 1;
+      std::vector<std::uint64_t>           keys;
+      std::vector<typename dealii::DoFHandler<dim>::active_cell_iterator> cells;
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            keys.push_back(cell_key(cell->id(), dim, level));
+            cells.push_back(cell);
+          }
+      const auto records = Run::read_records(directory.file("cells"), keys, this->get_scene().mpi_communicator());
+      const auto vectors = state_vectors();
+      std::vector<dealii::types::global_dof_index> dofs(fe->n_dofs_per_cell());
+      for (std::size_t k = 0; k < cells.size(); ++k)
+        {
+          std::istringstream bytes(records[k]);
+          CheckpointReader   in(bytes, directory.file("cells"));
+          cells[k]->get_dof_indices(dofs);
+          for (Vector *x : vectors)
+            for (const auto i : dofs)
+              {
+                const double value = in.get<double>();
+                if (owned_dofs.is_element(i))
+                  (*x)(i) = value;
+              }
+          CellHistory<dim> &h       = *cell_history[cells[k]->active_cell_index()];
+          const std::size_t n_q     = h.stress.size();
+          const std::size_t n_state = h.state.size();
+          in &h;
+          if (h.stress.size() != n_q || h.strain.size() != n_q || h.state.size() != n_state ||
+              h.volume.size() != n_q || h.tangent.size() != n_q || !in.at_end())
+            in.refuse("a cell's state has another size than the scene's (another mesh, element or material)");
+          h.trial_volume = h.volume;
+        }
+      for (Vector *x : vectors)
+        x->compress(dealii::VectorOperation::insert);
       u_ghost = u;
       v_ghost = v;
       a_ghost = a;
-      in.section("fem history");
-      for (const auto &cell : triangulation->active_cell_iterators())
-        if (cell->is_locally_owned())
-          {
-            CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
-            const std::size_t n_q = h.stress.size(), n_state = h.state.size();
-            in.get(h.stress);
-            in.get(h.strain);
-            in.get(h.state);
-            in.get(h.volume);
-            in.get(h.tangent);
-            if (h.stress.size() != n_q || h.strain.size() != n_q || h.state.size() != n_state ||
-                h.volume.size() != n_q || h.tangent.size() != n_q)
-              in.refuse("a cell's quadrature-point history has another size than the scene's");
-            h.trial_volume = h.volume;
-          }
-      in.section("fem sums");
-      in.get(internal_work);
-      in.get(external_work);
-      in.get(boundary_work);
-      in.get(force_scale);
-      in.get(last_force_level);
-      in.get(predictor_level);
-      in.get(current_dt);
-      in.get(initial_kinetic);
-      in.get(wall_forces);
-      in.get(n_newton);
-      in.get(n_cuts);
-      in.get(n_linear);
-      increments.restore(in.get<std::array<double, 4>>());
-      in.get(step_checked);
-      tables.serialize(in);
     }
 
     template void Solver<2>::save(CheckpointWriter &, CheckpointWriter &, const CheckpointDirectory &) const;

@@ -91,6 +91,14 @@ namespace hysteron
       std::vector<double>                          volume, trial_volume;
       std::vector<dealii::Point<dim>>              point;  ///< quadrature points (reference configuration)
 
+      /// The converged state, in a checkpoint (the trial state is recomputed from it).
+      template <class Archive>
+      void
+      serialize(Archive &ar)
+      {
+        ar &stress &strain &state &volume &tangent;
+      }
+
       /// 2D: sigma_zz at point q of the trial (or the converged) state (the hoop stress
       /// of an axisymmetric model).
       double
@@ -170,6 +178,15 @@ namespace hysteron
       save(CheckpointWriter &global, CheckpointWriter &rank, const CheckpointDirectory &directory) const override;
       void
       load(CheckpointReader &global, std::vector<CheckpointReader> &rank_parts, const CheckpointDirectory &directory) override;
+
+      /// The global part (the same on every rank) and a rank's part of the state, for
+      /// save() and load() alike.
+      template <class Archive>
+      void
+      serialize_global(Archive &ar);
+      template <class Archive>
+      void
+      serialize_rank(Archive &ar);
 
     private:
       using Vector = dealii::TrilinosWrappers::MPI::Vector;
@@ -516,6 +533,12 @@ namespace hysteron
       // (f_int + inertia - f_ext) those of the converged state, which the output reads.
       Vector u, u_ghost, v, v_ghost, a, a_ghost, u_trial;
       Vector f_int, f_ext, f_int_old, f_ext_old, inertia, lumped_mass, reaction_old;
+      /// The vectors of the state (a checkpoint's cell records hold their values).
+      std::array<Vector *, 10>
+      state_vectors()
+      {
+        return {{&u, &v, &a, &u_trial, &f_int, &f_ext, &f_int_old, &f_ext_old, &inertia, &reaction_old}};
+      }
       dealii::BoundingBox<dim> mesh_box;
       double                   u_scale = 0;    ///< characteristic length for tolerances [m]
       double                   force_scale = 0; ///< largest force norm seen (Newton floor)
