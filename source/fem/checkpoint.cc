@@ -149,27 +149,29 @@ namespace hysteron
       const auto records = Run::read_records(directory.file("cells"), keys, this->get_scene().mpi_communicator());
       const auto vectors = state_vectors();
       std::vector<dealii::types::global_dof_index> dofs(fe->n_dofs_per_cell());
-      for (std::size_t k = 0; k < cells.size(); ++k)
-        {
-          std::istringstream bytes(records[k]);
-          CheckpointReader   in(bytes, directory.file("cells"));
-          cells[k]->get_dof_indices(dofs);
-          for (Vector *x : vectors)
-            for (const auto i : dofs)
-              {
-                const double value = in.get<double>();
-                if (owned_dofs.is_element(i))
-                  (*x)(i) = value;
-              }
-          CellHistory<dim> &h       = *cell_history[cells[k]->active_cell_index()];
-          const std::size_t n_q     = h.stress.size();
-          const std::size_t n_state = h.state.size();
-          in &h;
-          if (h.stress.size() != n_q || h.strain.size() != n_q || h.state.size() != n_state ||
-              h.volume.size() != n_q || h.tangent.size() != n_q || !in.at_end())
-            in.refuse("a cell's state has another size than the scene's (another mesh, element or material)");
-          h.trial_volume = h.volume;
-        }
+      Run::parse_collectively(this->get_scene().mpi_communicator(), [&]() {
+        for (std::size_t k = 0; k < cells.size(); ++k)
+          {
+            std::istringstream bytes(records[k]);
+            CheckpointReader   in(bytes, directory.file("cells"));
+            cells[k]->get_dof_indices(dofs);
+            for (Vector *x : vectors)
+              for (const auto i : dofs)
+                {
+                  const double value = in.get<double>();
+                  if (owned_dofs.is_element(i))
+                    (*x)(i) = value;
+                }
+            CellHistory<dim> &h       = *cell_history[cells[k]->active_cell_index()];
+            const std::size_t n_q     = h.stress.size();
+            const std::size_t n_state = h.state.size();
+            in &h;
+            if (h.stress.size() != n_q || h.strain.size() != n_q || h.state.size() != n_state ||
+                h.volume.size() != n_q || h.tangent.size() != n_q || !in.at_end())
+              in.refuse("a cell's state has another size than the scene's (another mesh, element or material)");
+            h.trial_volume = h.volume;
+          }
+      });
       for (Vector *x : vectors)
         x->compress(dealii::VectorOperation::insert);
       u_ghost = u;

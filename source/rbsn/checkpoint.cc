@@ -1,126 +1,147 @@
-// The RBSN's part of a checkpoint: the DoF vectors, every facet's springs (converged
-// and trial state, tangent, broken or not), the increment control and the work sums.
-// Every rank writes (and reads) its own cells' DoFs and its own facets; a checkpoint of
-// N ranks resumes on N ranks, which build the same network.
+// The RBSN's part of a checkpoint, readable on any number of ranks:
+//  - one record per cell, keyed by its global number (the same on any number of
+//    ranks: the same parameters and Random seed give the same network), with the
+//    cell's values of the DoF vectors and the springs of the facets it owns (those
+//    whose other cell has the higher number), each marked with that other cell;
+//  - the global state (step control, counters, works, tables);
+//  - each rank's incrementally assembled tangent (its rows of the matrix), used only
+//    on as many ranks: on another number the first step assembles it anew.
 #include <hysteron/rbsn/model.h>
 
 #include <Epetra_CrsMatrix.h>
+
+#include "run/keyed_records.h"
+
+#include <map>
+#include <sstream>
 
 namespace hysteron
 {
   namespace RBSN
   {
-    template <int dim>
-    void
-    Model<dim>::save(CheckpointWriter &out) const
+    namespace
     {
-      const auto put_vector = [&](const Vector &x) {
-        out.put(std::vector<double>(x.begin(), x.begin() + x.locally_owned_size()));
-      };
-      out.section("rbsn vectors");
-      out.put<std::uint64_t>(u.size());
-      for (const Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia,
-                              &reaction_old})
-        put_vector(*x);
-      out.section("rbsn spring laws");
-      out.put<std::uint64_t>(springs.size());
-      for (const auto &sp : springs)
-        {
-          out.put(sp.delta);
-          out.put(sp.force);
-          out.put(sp.trial_delta);
-          out.put(sp.trial_force);
-          out.put(sp.state);
-          out.put(sp.trial_state);
-          out.put(sp.tangent);
-          out.put(sp.broken);
-        }
-      out.section("rbsn sums");
-      out.put(force_scale);
-      out.put(last_force_level);
-      out.put(predictor_level);
-      out.put(internal_work);
-      out.put(external_work);
-      out.put(boundary_work);
-      out.put(n_steps);
-      out.put(n_newton);
-      out.put(n_broken);
-      out.put(n_cuts);
-      out.put(increments.state());
-      out.section("rbsn fracture energy, factorizations");
-      out.put(fracture_energy);
-      out.put(n_factorizations);
-      // The incrementally assembled tangent: which facets' tangents it holds, and its values.
-      out.section("rbsn assembled tangent");
-      out.put(matrix_current);
-      out.put(matrix_dt);
-      out.put(incremental_updates);
-      if (matrix_current)
-        {
-          out.put(facet_in_matrix);
-          out.put(assembled_tangent);
-          out.put(matrix_values());
-        }
-      const_cast<PointData::Tables<dim> &>(tables).serialize(out);
+      /// A facet's springs: the converged and trial state and the tangent.
+      template <int dim, class Archive, class SpringsType>
+      void
+      serialize_springs(Archive &ar, SpringsType &sp)
+      {
+        ar &sp.delta &sp.force &sp.trial_delta &sp.trial_force &sp.state &sp.trial_state &sp.tangent &sp.broken;
+      }
+    } // namespace
+
+
+
+    template <int dim>
+    template <class Archive>
+    void
+    Model<dim>::serialize_global(Archive &ar)
+    {
+      ar.section("rbsn");
+      auto increment_state = increments.state();
+      ar &force_scale &last_force_level &predictor_level &internal_work &external_work &boundary_work &n_steps
+        &n_newton &n_broken &n_cuts &increment_state &fracture_energy &n_factorizations;
+      if constexpr (Archive::is_loading)
+        increments.restore(increment_state);
+      tables.serialize(ar);
     }
 
 
 
     template <int dim>
     void
-    Model<dim>::load(CheckpointReader &in)
+    Model<dim>::save(CheckpointWriter &global, CheckpointWriter &rank, const CheckpointDirectory &directory) const
     {
-      const auto get_vector = [&](Vector &x) {
-        std::vector<double> values;
-        in.get(values);
-        if (values.size() != x.locally_owned_size())
-          in.refuse("the network has another number of DoFs than the checkpoint's");
-        x = 0;
-        std::copy(values.begin(), values.end(), x.begin());
-      };
-      in.section("rbsn vectors");
-      if (in.get<std::uint64_t>() != u.size())
-        in.refuse("the network has another number of DoFs than the checkpoint's (the same "
-                  "parameters and Random seed give the same network)");
-      for (Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
-        get_vector(*x);
+      auto &self = const_cast<Model<dim> &>(*this); // serialize() only reads when saving
+      self.serialize_global(global);
+
+      // The incrementally assembled tangent: which facets' tangents it holds, and its values.
+      rank.section("rbsn assembled tangent");
+      rank.put(matrix_current);
+      rank.put(matrix_dt);
+      rank.put(incremental_updates);
+      if (matrix_current)
+        {
+          rank.put(facet_in_matrix);
+          rank.put(assembled_tangent);
+          rank.put(matrix_values());
+        }
+
+      // A replicated network (every rank holds all of it) is written by rank 0.
+      const MPI_Comm comm = scene.mpi_communicator();
+      std::vector<std::pair<std::uint64_t, std::string>> records;
+      if (distributed() || dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+        for (unsigned int c = 0; c < n_owned_cells; ++c)
+          {
+            std::ostringstream bytes;
+            CheckpointWriter   out(bytes);
+            for (const Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
+              for (unsigned int k = 0; k < n_dofs; ++k)
+                out.put(x->local_element(n_dofs * c + k));
+            out.put<std::uint64_t>(owned_facet_start[c + 1] - owned_facet_start[c]);
+            for (unsigned int e = owned_facet_start[c]; e < owned_facet_start[c + 1]; ++e)
+              {
+                out.put<std::uint64_t>(cell_id[network.facets[e].b]);
+                serialize_springs<dim>(out, self.springs[e]);
+              }
+            records.emplace_back(cell_id[c], bytes.str());
+          }
+      Run::write_records(directory.file("cells"), n_cells, records, comm);
+    }
+
+
+
+    template <int dim>
+    void
+    Model<dim>::load(CheckpointReader              &global,
+                     std::vector<CheckpointReader> &rank_parts,
+                     const CheckpointDirectory     &directory)
+    {
+      serialize_global(global);
+
+      std::vector<std::uint64_t> keys(cell_id.begin(), cell_id.begin() + n_owned_cells);
+      const auto records = Run::read_records(directory.file("cells"), keys, scene.mpi_communicator());
+      const std::string file = directory.file("cells");
+      Run::parse_collectively(scene.mpi_communicator(), [&]() {
+        for (unsigned int c = 0; c < n_owned_cells; ++c)
+          {
+            std::istringstream bytes(records[c]);
+            CheckpointReader   in(bytes, file);
+            for (Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
+              for (unsigned int k = 0; k < n_dofs; ++k)
+                in.get(x->local_element(n_dofs * c + k));
+            // The facets by their other cell: the local order may differ on another partition.
+            std::map<std::uint64_t, unsigned int> facet_of;
+            for (unsigned int e = owned_facet_start[c]; e < owned_facet_start[c + 1]; ++e)
+              facet_of[cell_id[network.facets[e].b]] = e;
+            const auto n_facets = in.get<std::uint64_t>();
+            if (n_facets != facet_of.size())
+              in.refuse("cell " + std::to_string(cell_id[c]) + " has another number of facets than in the "
+                        "checkpoint (the same parameters and Random seed give the same network)");
+            for (std::uint64_t f = 0; f < n_facets; ++f)
+              {
+                const auto found = facet_of.find(in.get<std::uint64_t>());
+                if (found == facet_of.end())
+                  in.refuse("cell " + std::to_string(cell_id[c]) + " has other neighbours than in the checkpoint");
+                auto             &sp      = springs[found->second];
+                const std::size_t n_state = sp.state.size();
+                serialize_springs<dim>(in, sp);
+                if (sp.state.size() != n_state || sp.trial_state.size() != n_state)
+                  in.refuse("the facets' spring states differ from the checkpoint's (another RBSN/Spring law or "
+                            "Analysis)");
+              }
+            if (!in.at_end())
+              in.refuse("a cell's record is longer than this network's cell (another network)");
+          }
+      });
       for (Vector *x : {&u, &u_trial, &v, &a})
         x->update_ghost_values();
-      in.section("rbsn spring laws");
-      if (in.get<std::uint64_t>() != springs.size())
-        in.refuse("the network has another number of facets than the checkpoint's");
-      for (auto &sp : springs)
-        {
-          in.get(sp.delta);
-          in.get(sp.force);
-          in.get(sp.trial_delta);
-          in.get(sp.trial_force);
-          // The spring law's state: as many doubles per facet as this run's law keeps.
-          const std::size_t n_state = sp.state.size();
-          in.get(sp.state);
-          in.get(sp.trial_state);
-          if (sp.state.size() != n_state || sp.trial_state.size() != n_state)
-            in.refuse("the facets' spring states differ from the checkpoint's (another "
-                      "RBSN/Spring law or Analysis)");
-          in.get(sp.tangent);
-          in.get(sp.broken);
-        }
-      in.section("rbsn sums");
-      in.get(force_scale);
-      in.get(last_force_level);
-      in.get(predictor_level);
-      in.get(internal_work);
-      in.get(external_work);
-      in.get(boundary_work);
-      in.get(n_steps);
-      in.get(n_newton);
-      in.get(n_broken);
-      in.get(n_cuts);
-      increments.restore(in.get<std::array<double, 4>>());
-      in.section("rbsn fracture energy, factorizations");
-      in.get(fracture_energy);
-      in.get(n_factorizations);
       update_fragments(); // from the broken facets
+
+      matrix_current = false; // on another partition the first step assembles anew
+      if (!directory.same_ranks())
+        return;
+      CheckpointReader &in = rank_parts[0];
       in.section("rbsn assembled tangent");
       in.get(matrix_current);
       in.get(matrix_dt);
@@ -135,7 +156,6 @@ namespace hysteron
             throw RuntimeError("the checkpoint's assembled tangent does not match the network");
           set_matrix_values(values);
         }
-      tables.serialize(in);
     }
 
 

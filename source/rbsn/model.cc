@@ -1071,22 +1071,18 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::save(CheckpointWriter &, CheckpointWriter &rank, const CheckpointDirectory &) const
+    Solver<dim>::save(CheckpointWriter &global, CheckpointWriter &rank, const CheckpointDirectory &directory) const
     {
-      model->save(rank);
+      model->save(global, rank, directory);
     }
 
     template <int dim>
     void
-    Solver<dim>::load(CheckpointReader &,
+    Solver<dim>::load(CheckpointReader              &global,
                       std::vector<CheckpointReader> &rank_parts,
                       const CheckpointDirectory     &directory)
     {
-      if (!directory.same_ranks())
-        throw InputError("--resume",
-                         "the rbsn method resumes on as many MPI ranks as wrote the checkpoint (" +
-                           std::to_string(directory.saved_ranks) + ")");
-      model->load(rank_parts[0]);
+      model->load(global, rank_parts, directory);
     }
 
     template <int dim>

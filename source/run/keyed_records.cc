@@ -136,13 +136,16 @@ namespace hysteron
           index.push_back(r.second.size());
           data += r.second;
         }
+      const bool last_key_held =
+        dealii::Utilities::MPI::logical_or(!keys.empty() && keys.back() == n_keys - 1, comm);
       File records_file(path, MPI_MODE_CREATE | MPI_MODE_WRONLY, comm);
       File index_file(path + ".index", MPI_MODE_CREATE | MPI_MODE_WRONLY, comm);
       try
         {
           records_file.write(first, data.data(), data.size());
-          // The index's last entry fixes its size, whoever holds that key.
-          if (dealii::Utilities::MPI::this_mpi_process(comm) == 0 && n_keys > 0)
+          // The index's last entry fixes its size: rank 0 writes it empty if no rank holds
+          // that key (and only then: two ranks writing the same bytes race).
+          if (dealii::Utilities::MPI::this_mpi_process(comm) == 0 && n_keys > 0 && !last_key_held)
             {
               const std::uint64_t none[2] = {0, 0};
               index_file.write(16 * (n_keys - 1), reinterpret_cast<const char *>(none), 16);

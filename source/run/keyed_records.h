@@ -1,6 +1,10 @@
 #ifndef hysteron_source_run_keyed_records_h
 #define hysteron_source_run_keyed_records_h
 
+#include <hysteron/base/exceptions.h>
+
+#include <deal.II/base/mpi.h>
+
 #include <mpi.h>
 
 #include <cstdint>
@@ -33,6 +37,30 @@ namespace hysteron
     /// Collective. Throws RuntimeError naming the file if it cannot be read.
     std::vector<std::string>
     read_records(const std::string &path, const std::vector<std::uint64_t> &keys, MPI_Comm comm);
+
+    /**
+     * Runs @p read_records_of_this_rank (which parses this rank's records and may
+     * throw InputError) on every rank, and throws the first rank's InputError on every
+     * rank if any rank's threw: a damaged record refuses the resume everywhere, not on
+     * one rank while the others wait in the next collective call. Collective.
+     */
+    template <typename Function>
+    void
+    parse_collectively(MPI_Comm comm, const Function &read_records_of_this_rank)
+    {
+      std::pair<std::string, std::string> error;
+      try
+        {
+          read_records_of_this_rank();
+        }
+      catch (const InputError &e)
+        {
+          error = {e.where(), e.problem()};
+        }
+      for (const auto &[where, problem] : dealii::Utilities::MPI::all_gather(comm, error))
+        if (!problem.empty())
+          throw InputError(where, problem);
+    }
   } // namespace Run
 } // namespace hysteron
 

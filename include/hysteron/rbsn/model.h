@@ -170,10 +170,12 @@ namespace hysteron
       /// Why this analysis cannot be checkpointed ("" if it can).
       std::string
       checkpoint_unsupported() const;
+      /// The network's state as records keyed by cell (any number of ranks resumes
+      /// it), the global state in @p global, this rank's assembled tangent in @p rank.
       void
-      save(CheckpointWriter &out) const;
+      save(CheckpointWriter &global, CheckpointWriter &rank, const CheckpointDirectory &directory) const;
       void
-      load(CheckpointReader &in);
+      load(CheckpointReader &global, std::vector<CheckpointReader> &rank_parts, const CheckpointDirectory &directory);
       /// The values of the system matrix (this rank's rows), in the pattern's order.
       std::vector<double>
       matrix_values() const;
@@ -198,6 +200,12 @@ namespace hysteron
 
     private:
       using Vector       = dealii::LinearAlgebra::distributed::Vector<double>;
+
+      /// The state the same on every rank (step control, counters, works, tables).
+      template <class Archive>
+      void
+      serialize_global(Archive &ar);
+
       using SpringVector = typename SpringLaw<dim>::Vector;
       using SpringMatrix = typename SpringLaw<dim>::Matrix;
       using dof_index    = dealii::types::global_dof_index;
