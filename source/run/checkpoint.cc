@@ -82,6 +82,16 @@ namespace hysteron
         return text;
       }
 
+
+
+      /// The CRC-32 of @p text.
+      std::uint32_t
+      text_crc(const std::string &text)
+      {
+        return static_cast<std::uint32_t>(
+          crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef *>(text.data()), static_cast<uInt>(text.size())));
+      }
+
       /// "<kind> <bytes> <crc> <path>" lines of info.txt (the path last: it may hold spaces).
       void
       write_digests(std::ostream &out, const std::string &kind, const std::vector<FileDigest> &list)
@@ -94,15 +104,33 @@ namespace hysteron
       bool
       read_info(const fs::path &directory, CheckpointFile &file, std::string &why)
       {
-        std::ifstream in(directory / "info.txt");
-        std::string   line;
         file           = CheckpointFile();
         file.directory = directory.string();
-        if (!std::getline(in, line))
+        std::string text;
+        {
+          std::ifstream     whole(directory / "info.txt", std::ios::binary);
+          std::stringstream buffer;
+          buffer << whole.rdbuf();
+          text = buffer.str();
+        }
+        if (text.empty())
           {
             why = "info.txt is missing or empty";
             return false;
           }
+        // The last line, "end <CRC-32 of the text before it>", guards info.txt itself.
+        const std::size_t end = text.rfind("end ");
+        if (end == std::string::npos || (end > 0 && text[end - 1] != '\n') ||
+            text.substr(end) != "end " + hex(text_crc(text.substr(0, end))) + "\n")
+          {
+            why = text.rfind("hysteron checkpoint", 0) == 0 && text.compare(0, magic.size(), magic) != 0 ?
+                    "it was written by another version of hysteron" :
+                    "info.txt is damaged (its CRC-32 does not match)";
+            return false;
+          }
+        std::istringstream in(text.substr(0, end));
+        std::string        line;
+        std::getline(in, line);
         if (line != magic)
           {
             why = line.rfind("hysteron checkpoint", 0) == 0 ?
@@ -139,7 +167,7 @@ namespace hysteron
                 std::getline(fields >> std::ws, d.path);
                 (key == "file" ? file.files : key == "table" ? file.tables : file.inputs).push_back(d);
               }
-            else if (key != "end")
+            else
               {
                 why = "info.txt is damaged";
                 return false;
@@ -409,6 +437,54 @@ namespace hysteron
 
 
 
+    namespace
+    {
+      /// Why the intact checkpoint @p file is of another run than this one (its inputs,
+      /// method or parameters differ; "" if none).
+      std::string
+      stale_reason(const CheckpointFile            &file,
+                   const std::string               &name,
+                   const std::vector<FileDigest>   &inputs,
+                   const std::string               &method,
+                   const std::string               &parameters)
+      {
+        for (const auto &recorded : file.inputs)
+          {
+            const auto now = std::find_if(inputs.begin(), inputs.end(), [&](const FileDigest &d) {
+              return d.path == recorded.path;
+            });
+            if (now == inputs.end() || !(*now == recorded))
+              return "the input file '" + recorded.path + "' changed since " + name + " was written (" +
+                     std::to_string(recorded.bytes) + " bytes, CRC-32 " + hex(recorded.crc) + "; now " +
+                     (now == inputs.end() ? std::string("not read by the scene") :
+                                            std::to_string(now->bytes) + " bytes, CRC-32 " + hex(now->crc)) +
+                     "): a resumed run must read the inputs of the run it continues";
+          }
+        std::ifstream    in(file.global_file(), std::ios::binary);
+        CheckpointReader reader(in, file.global_file());
+        std::string      written_by, written_parameters;
+        try
+          {
+            reader.section("driver");
+            reader.get(written_by);
+            reader.get(written_parameters);
+          }
+        catch (const InputError &e)
+          {
+            return e.what(); // intact by its digest, but not a checkpoint of this program
+          }
+        const std::string difference = first_difference(written_parameters, resumable_parameters(parameters));
+        if (written_by != method)
+          return name + " was written by the method '" + written_by + "', not '" + method + "'";
+        if (!difference.empty())
+          return "the scene's parameters differ from " + name +
+                 "'s (only `subsection Checkpoint` and Output/Progress interval may change): " + difference;
+        return "";
+      }
+    } // namespace
+
+
+
     CheckpointFile
     find_resumable_checkpoint(const std::string             &directory,
                               const std::string             &method,
@@ -444,70 +520,29 @@ namespace hysteron
           const std::string name = fs::path(candidate).filename().string();
           CheckpointFile    file;
           std::string       why;
-          std::string       stale; // a refusal that an older checkpoint cannot mend
-          if (root && read_info(candidate, file, why))
-            {
-              // The run's inputs: the same files with the same contents.
-              for (const auto &recorded : file.inputs)
-                {
-                  const auto now = std::find_if(inputs.begin(), inputs.end(), [&](const FileDigest &d) {
-                    return d.path == recorded.path;
-                  });
-                  if (now == inputs.end() || !(*now == recorded))
-                    {
-                      stale = "the input file '" + recorded.path + "' changed since " + name +
-                              " was written (" + std::to_string(recorded.bytes) + " bytes, CRC-32 " +
-                              hex(recorded.crc) + "; now " +
-                              (now == inputs.end() ? std::string("not read by the scene") :
-                                                     std::to_string(now->bytes) + " bytes, CRC-32 " + hex(now->crc)) +
-                              "): a resumed run must read the inputs of the run it continues";
-                      break;
-                    }
-                }
-              // The method and the parameters (global.bin's header).
-              if (stale.empty())
-                {
-                  std::ifstream    in(file.global_file(), std::ios::binary);
-                  CheckpointReader reader(in, file.global_file());
-                  try
-                    {
-                      std::string written_by, written_parameters;
-                      reader.section("driver");
-                      reader.get(written_by);
-                      reader.get(written_parameters);
-                      const std::string difference =
-                        first_difference(written_parameters, resumable_parameters(parameters));
-                      if (written_by != method)
-                        stale = name + " was written by the method '" + written_by + "', not '" + method + "'";
-                      else if (!difference.empty())
-                        stale = "the scene's parameters differ from " + name +
-                                "'s (only `subsection Checkpoint` and Output/Progress interval "
-                                "may change): " +
-                                difference;
-                    }
-                  catch (const InputError &)
-                    {
-                      // A damaged global.bin: its CRC tells below.
-                    }
-                }
-            }
-          why   = dealii::Utilities::MPI::broadcast(comm, why, 0);
-          stale = dealii::Utilities::MPI::broadcast(comm, stale, 0);
-          if (!stale.empty())
-            throw InputError("--resume", stale);
+          // First whether the checkpoint is intact (every file against its digest): a
+          // damaged one is skipped for an older one, whatever its damaged bytes say.
+          if (root)
+            read_info(candidate, file, why);
+          why = dealii::Utilities::MPI::broadcast(comm, why, 0);
           if (why.empty())
             {
               file = dealii::Utilities::MPI::broadcast(comm, file, 0);
               why  = damage(file, directory, comm);
-              if (why.empty())
-                {
-                  if (root && !refused.empty())
-                    notes << "hysteron: --resume: " << refused.size() << " newer checkpoint"
-                          << (refused.size() > 1 ? "s are" : " is") << " not usable ("
-                          << refused.front() << (refused.size() > 1 ? "; ..." : "") << "); resuming from "
-                          << name << std::endl;
-                  return file;
-                }
+            }
+          if (why.empty())
+            {
+              // An intact checkpoint of another run (other inputs, method or parameters):
+              // an older one is of that run too, so the resume is refused.
+              const std::string stale =
+                dealii::Utilities::MPI::broadcast(comm, root ? stale_reason(file, name, inputs, method, parameters) : "", 0);
+              if (!stale.empty())
+                throw InputError("--resume", stale);
+              if (root && !refused.empty())
+                notes << "hysteron: --resume: " << refused.size() << " newer checkpoint"
+                      << (refused.size() > 1 ? "s are" : " is") << " not usable (" << refused.front()
+                      << (refused.size() > 1 ? "; ..." : "") << "); resuming from " << name << std::endl;
+              return file;
             }
           refused.push_back(name + ": " + why);
         }
@@ -617,14 +652,15 @@ namespace hysteron
             d.path = fs::path(d.path).lexically_relative(directory).string();
           std::error_code ec;
           {
-            std::ofstream info(temporary / "info.txt");
-            char          time_text[64];
+            std::ostringstream text;
+            char               time_text[64];
             std::snprintf(time_text, sizeof(time_text), "%a", t);
-            info << magic << "\nstep " << step << "\ntime " << time_text << "\nranks " << n_ranks << "\n";
-            write_digests(info, "file", file.files);
-            write_digests(info, "table", file.tables);
-            write_digests(info, "input", inputs);
-            info << "end\n";
+            text << magic << "\nstep " << step << "\ntime " << time_text << "\nranks " << n_ranks << "\n";
+            write_digests(text, "file", file.files);
+            write_digests(text, "table", file.tables);
+            write_digests(text, "input", inputs);
+            std::ofstream info(temporary / "info.txt");
+            info << text.str() << "end " << hex(text_crc(text.str())) << "\n";
             info.close();
             if (!info)
               problem = "cannot write '" + (temporary / "info.txt").string() + "'";

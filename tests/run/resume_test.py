@@ -34,7 +34,8 @@ from run_prm_test import compare_csv  # noqa: E402  (the 1-rank/2-rank compariso
 
 
 def run(command, cwd, env, timeout=900):
-    p = subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+    p = subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True, errors="replace",
+                       timeout=timeout)
     return p.returncode, p.stdout, p.stderr
 
 
