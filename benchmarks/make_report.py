@@ -121,6 +121,14 @@ def studies(args, out, work):
         Study("pay_for_use", py("pay_for_use.py", "--out", out), 10, in_quick=False),
         Study("mpm_throughput", py("run_mpm_benchmark.py", "--repeats", r, "--out", out), 3,
               exclusive=True, in_quick=False),
+        # Set-up and memory against the grid, the mesh and the ranks (up to 8 ranks,
+        # oversubscribed: memory is measured faithfully, time is not): alone.
+        Study("scaling_mpm", py("scaling_mpm.py", "--repeats", r, "--out", out, "--workdir", f"{work}/scaling_mpm", *q),
+              10, exclusive=True, in_quick=False),
+        Study("scaling_fem",
+              [PY, os.path.join(bench, "scaling_fem.py"), "--hysteron", os.path.join(b, "hysteron"),
+               "--workdir", f"{work}/scaling_fem", "--out", os.path.join(out, "scaling_fem.md")], 10,
+              exclusive=True, in_quick=False),
         # The 3D plate of 531,441 DoFs on 2 ranks, and the 2-rank speed-up on a quarter of it:
         # both cores, one run each (about 25 and 12 minutes).
         Study("fem_plate_3d",
