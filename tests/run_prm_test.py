@@ -13,6 +13,7 @@ The scene runs in a fresh working directory (relative output paths land there) w
                                   or a manifest; with EXIT: 2, a run that failed, complete files
                                   of the last good state may stay, but no *.tmp)
   # EXIT: <n>                     the expected non-zero exit status (with EXPECT-ERROR)
+  # MAX-SECONDS: <s>              the (first) run must take at most s seconds of CPU time
   # EXPECT-STDERR: <regex>        stderr must match (e.g. a warning) on a successful run
   # EXPECT-STDOUT: <regex>        stdout must match on a successful run
   # ARGS: <arguments>             command line instead of "--quiet <prm>" ({prm} = the file)
@@ -22,9 +23,13 @@ The scene runs in a fresh working directory (relative output paths land there) w
                                   copied into the working directory with the .prm
   # MPI: 2                        also run on 2 ranks; every output file must be identical
                                   (with EXPECT-ERROR: the run must fail in the same way)
-  # MPI-TOLERANCE: 1e-10[, 1e-14] with MPI: CSV values may differ by this fraction of the
+  # MPI-TOLERANCE: 1e-10[, 1e-14][, s_xy=1e-3, ...]
+                                  with MPI: CSV values may differ by this fraction of the
                                   largest magnitude in their column (sums in another order),
-                                  or by the optional absolute amount (columns of round-off)
+                                  or by the optional absolute amount (columns of round-off);
+                                  name=value sets the absolute amount of the columns that
+                                  match the pattern name (fnmatch), e.g. a stress column of
+                                  round-off in Pa beside displacements of 1e-4 m
   # MPI-IGNORE: newton.csv        with MPI: files that must exist on 2 ranks but whose values
                                   are not compared (solver diagnostics such as residual norms
                                   at round-off level)
@@ -36,9 +41,11 @@ Exit status 0 when every assertion holds; the failures are printed otherwise.
 import argparse
 import csv
 import filecmp
+import fnmatch
 import math
 import os
 import re
+import resource
 import shutil
 import subprocess
 import sys
@@ -53,7 +60,7 @@ SAFE = {
 def parse_directives(path):
     directives = []
     pattern = re.compile(r"^\s*#\s*(CHECK-LAST|CHECK-COLUMNS|CHECK|EXPECT-ERROR|EXPECT-STDERR|EXPECT-STDOUT|EXIT|"
-                         r"ARGS|FILES|RANKS|MPI-TOLERANCE|MPI-IGNORE|MPI)\b\s*([^:]*):\s?(.*)$")
+                         r"ARGS|FILES|RANKS|MAX-SECONDS|MPI-TOLERANCE|MPI-IGNORE|MPI)\b\s*([^:]*):\s?(.*)$")
     with open(path) as f:
         for line in f:
             m = pattern.match(line)
@@ -87,8 +94,10 @@ def output_files(directory):
 
 def compare_csv(path_one, path_two, tolerance):
     """None if the tables agree to tolerance[0] times each column's largest magnitude
-    (or to the absolute tolerance[1])."""
-    relative, absolute = tolerance
+    (or to the absolute tolerance[1], or that of tolerance[2] for the columns matching a
+    pattern there)."""
+    relative, default_absolute, *rest = tolerance
+    columns = rest[0] if rest else {}
     header1, one = read_csv(path_one)
     header2, two = read_csv(path_two)
     if header1 != header2:
@@ -96,6 +105,8 @@ def compare_csv(path_one, path_two, tolerance):
     if len(one) != len(two):
         return f"{len(two)} rows instead of {len(one)}"
     for c, name in enumerate(header1):
+        absolute = next((a for pattern, a in columns.items() if fnmatch.fnmatchcase(name, pattern)),
+                        default_absolute)
         scale = max([abs(r[c]) for r in one] + [1e-300])
         for i, (a, b) in enumerate(zip(one, two)):
             if abs(a[c] - b[c]) > max(relative * scale, absolute):
@@ -138,8 +149,16 @@ def main():
     main_command = ([args.mpiexec, "-np", ranks_line.strip()] + command) if ranks_line else command
     failures = []
 
+    # The CPU time of the run (user + system, its children's too): unlike the wall time it
+    # does not grow when other tests share the cores.
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     code, out, err = run(main_command, args.workdir, env)
-    print("$ " + " ".join(main_command))
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    seconds = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    print("$ " + " ".join(main_command) + f"  ({seconds:.2f} s of CPU)")
+    for k, _, v in directives:
+        if k == "MAX-SECONDS" and seconds > float(v):
+            failures.append(f"the run took {seconds:.2f} s of CPU, more than {v} s")
     if out:
         print(out[-4000:])
     if err:
@@ -231,8 +250,10 @@ def main():
         tolerance = None
         for k, _, v in directives:
             if k == "MPI-TOLERANCE":
-                parts = [float(x) for x in v.split(",")]
-                tolerance = (parts[0], parts[1] if len(parts) > 1 else 0.0)
+                parts = [x.strip() for x in v.split(",")]
+                numbers = [float(x) for x in parts if "=" not in x]
+                columns = {x.split("=")[0].strip(): float(x.split("=")[1]) for x in parts if "=" in x}
+                tolerance = (numbers[0], numbers[1] if len(numbers) > 1 else 0.0, columns)
         for k, _, v in directives:
             if k != "MPI" or expect_error:
                 continue
@@ -266,7 +287,7 @@ def main():
                     failures.append(f"{ranks} ranks: {f} differs from the 1-rank run")
 
     n_checks = sum(1 for k, _, _ in directives
-                   if k in ("CHECK", "CHECK-LAST", "CHECK-COLUMNS", "EXPECT-ERROR", "MPI",
+                   if k in ("CHECK", "CHECK-LAST", "CHECK-COLUMNS", "EXPECT-ERROR", "MPI", "MAX-SECONDS",
                             "EXPECT-STDERR", "EXPECT-STDOUT"))
     if n_checks == 0 and not expect_error:
         failures.append("the test has no assertion (add a CHECK, EXPECT-ERROR or MPI line)")

@@ -19,6 +19,7 @@
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_solver.h>
 
+#include <hysteron/base/memory.h>
 #include <hysteron/base/newton.h>
 #include <hysteron/base/parameters.h>
 #include <hysteron/fem/fem.h>
@@ -29,7 +30,6 @@
 #include <iomanip>
 #include <limits>
 #include <sstream>
-#include <unistd.h>
 namespace hysteron
 {
   namespace FEM
@@ -172,42 +172,43 @@ namespace hysteron
     void
     Solver<dim>::check_memory(const double coarse_cells, const unsigned int levels, const bool serial) const
     {
-      // Each refinement multiplies the cells by 2^dim: refuse a mesh that cannot fit in this
-      // machine's memory before making it (it would end in std::bad_alloc after minutes).
-      // About 2 kB per quadrature point (history, tangent, matrix rows) on each rank for its
-      // share of the cells, the ranks of one machine together, and on rank 0 during the
-      // set-up of a mesh it makes whole (serial) the serial triangulation.
-      const MPI_Comm     comm  = this->get_scene().mpi_communicator();
-      const unsigned int rank  = dealii::Utilities::MPI::this_mpi_process(comm);
+      // Each refinement multiplies the cells by 2^dim: refuse a mesh that cannot fit in the
+      // ranks' memory before making it (it would end in std::bad_alloc after minutes). Each
+      // rank holds its share of the cells with their ghosts (Memory::largest_share), and
+      // rank 0, while it makes a whole mesh (serial), the serial triangulation too. A cell
+      // brings dim degree^dim DoFs (a node per cell of a large Q mesh; a simplex mesh has
+      // about 1/2 (2D) and 1/5 (3D) of that). The resident bytes per DoF (matrix rows,
+      // vectors, history and tangents at the quadrature points, the ML hierarchy) are the
+      // slopes of the peak RSS of one increment solved by CG + ML on unit squares and cubes,
+      // rounded up: 2D 2.2 kB (Q1, 3.3e4 ... 1.3e5 DoFs), 1.8 kB (Q2); 3D 4.9 kB (Q1,
+      // 1.5e4 ... 2.8e4 DoFs), 7.0 kB (Q2), measured by
+      //   benchmarks/memory_estimate.py --hysteron build/hysteron --only fem
+      // (each run /usr/bin/time -v hysteron scene.prm).
+      constexpr double   bytes_per_dof[2] = {2.2e3, 7e3};
+      const MPI_Comm     comm               = this->get_scene().mpi_communicator();
+      const unsigned int n_ranks            = dealii::Utilities::MPI::n_mpi_processes(comm);
       const double       given = coarse_cells * std::pow(2.0, dim * static_cast<double>(levels));
       const double       cells = given * std::pow(2.0, dim * static_cast<double>(refinements));
-      const double per_rank = cells / dealii::Utilities::MPI::n_mpi_processes(comm) * std::pow(degree + 1.0, dim) * 2e3;
-      const double on_root  = serial ? cells * serial_bytes_per_cell[dim - 2] : 0.0;
-      MPI_Comm     node;
-      MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node);
-      const unsigned int on_node   = dealii::Utilities::MPI::n_mpi_processes(node);
-      const bool         root_here = dealii::Utilities::MPI::logical_or(rank == 0, node);
-      MPI_Comm_free(&node);
-      const double memory = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * sysconf(_SC_PAGE_SIZE);
-      const double need   = on_node * per_rank + (root_here ? on_root : 0.0);
-      if (dealii::Utilities::MPI::max(need / memory, comm) <= 1)
-        return;
+      const double       per_cell =
+        dim * std::pow(degree, dim) / (simplex ? (dim == 2 ? 2.0 : 5.0) : 1.0) * bytes_per_dof[dim - 2];
+      const double       on_root  = serial ? cells * serial_bytes_per_cell[dim - 2] : 0.0;
+      const bool         root     = dealii::Utilities::MPI::this_mpi_process(comm) == 0;
       std::ostringstream m;
-      constexpr double   GiB = 1u << 30;
+      m.precision(3);
       if (refinements > 0)
-        m << "refining the mesh of " << given << " cells " << refinements << " times gives " << cells << " cells";
+        m << "refining the mesh of " << Memory::count(given) << " cells " << refinements << " times gives "
+          << Memory::count(cells) << " cells";
       else
-        m << "the mesh has " << cells << " cells";
-      m << " (" << cells / dealii::Utilities::MPI::n_mpi_processes(comm) << " per MPI rank), about "
-        << per_rank / GiB << " GiB per rank with " << (simplex ? "P" : "Q") << degree;
+        m << "the mesh has " << Memory::count(cells) << " cells";
+      m << " (" << per_cell << " B each with " << (simplex ? "P" : "Q") << degree << ")";
       if (serial)
-        m << " and " << on_root / GiB << " GiB more on rank 0 while it makes and partitions the whole mesh";
-      m << "; this machine has " << memory / GiB << " GiB for " << on_node
-        << " ranks: use fewer refinements, a coarser FEM/Mesh/Cell size or more machines";
-      throw InputError(refinements > 0 ? "FEM/Mesh/Refinements" :
-                       generator == "file" ? "FEM/Mesh/Mesh file" :
-                                             "FEM/Mesh/Cell size",
-                       m.str());
+        m << ", and " << serial_bytes_per_cell[dim - 2] << " B each on rank 0 while it makes the whole mesh";
+      Memory::require_fits(comm, Memory::largest_share(cells, n_ranks, dim) * per_cell + (root ? on_root : 0.0),
+                           refinements > 0       ? "FEM/Mesh/Refinements" :
+                           generator == "file" ? "FEM/Mesh/Mesh file" :
+                                                 "FEM/Mesh/Cell size",
+                           m.str(),
+                           "use fewer refinements, a coarser FEM/Mesh/Cell size or more machines");
     }
 
 

@@ -640,10 +640,12 @@ namespace hysteron
           if (!reached_only || reached_stamps == nullptr || reached_stamps[box] == *current_stamp)
             for (unsigned int b = 0; b < n_blocks_per_node; ++b)
               for (unsigned int c = first + b * size_of_block; c < first + b * size_of_block + n; ++c)
-                if (to_buffer)
-                  field.buffer.local_element(l + c) = values[std::size_t(box) * stride + c];
-                else if (double &v = values[std::size_t(box) * stride + c]; v != field.buffer.local_element(l + c))
-                  v = field.buffer.local_element(l + c); // a zero stays unwritten: no page
+                {
+                  if (to_buffer)
+                    field.buffer.local_element(l + c) = values[std::size_t(box) * stride + c];
+                  else if (double &v = values[std::size_t(box) * stride + c]; v != field.buffer.local_element(l + c))
+                    v = field.buffer.local_element(l + c); // a zero stays unwritten: no page
+                }
       };
       field.buffer.zero_out_ghost_values();
       copy(field.ghost_nodes, true, true);

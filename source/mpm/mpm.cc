@@ -5,6 +5,7 @@
 
 #include <hysteron/base/energy_check.h>
 #include <hysteron/base/exceptions.h>
+#include <hysteron/base/memory.h>
 #include <hysteron/base/parameters.h>
 #include "mpm/mpm.h"
 
@@ -38,6 +39,54 @@ namespace hysteron
       }
 
       const char *const *const component_suffix = PointData::component_names;
+
+      /**
+       * Refuse a run whose material points and grid cannot fit into the memory of the
+       * ranks, before the points are made. The points: k^dim per cell of volume h^dim of
+       * each body inside the grid (k = Particles per cell). The resident bytes per point
+       * (ParticleHandler, point arrays, material states, the nodes they reach) and per grid
+       * cell (p4est, the node arrays' untouched zero pages) are the slopes of the peak RSS
+       * of one-step runs of 3 sizes, rounded up: 580 B per point in 2D (4e4 ... 6.4e5
+       * points), 880 B in 3D (3.3e4 ... 2.6e5), 3 B per grid cell (a 0.1 m cube in grids of
+       * 50^3 ... 100^3 cells), measured by
+       *   benchmarks/memory_estimate.py --hysteron build/hysteron --only mpm
+       * (each run /usr/bin/time -v hysteron scene.prm, "Maximum resident set size").
+       */
+      template <int dim>
+      void
+      check_memory(const Scene<dim>                   &scene,
+                   const dealii::Point<dim>           &lower,
+                   const dealii::Point<dim>           &upper,
+                   const double                        cell_size,
+                   const std::array<unsigned int, dim> &n_cells)
+      {
+        constexpr double bytes_per_point[2] = {600, 900};
+        constexpr double bytes_per_cell[2]  = {16, 16};
+        double           points             = 0;
+        for (const auto &body : scene.body_descriptions())
+          {
+            const auto box     = body.shape.bounding_box();
+            double     in_grid = 1; // the volume of the body's box inside the grid
+            for (unsigned int d = 0; d < dim; ++d)
+              in_grid *= std::max(0.0, std::min(box.upper_bound(d), upper[d]) - std::max(box.lower_bound(d), lower[d]));
+            const double volume = body.shape.volume_estimate(); // infinite for an unbounded shape
+            points += std::min(volume, in_grid) / std::pow(cell_size, dim) * std::pow(body.particles_per_cell, dim);
+          }
+        double cells = 1;
+        for (unsigned int d = 0; d < dim; ++d)
+          cells *= n_cells[d];
+        const MPI_Comm     comm    = scene.mpi_communicator();
+        const unsigned int n_ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
+        const double       bytes   = Memory::largest_share(points, n_ranks, dim) * bytes_per_point[dim - 2] +
+                                 Memory::largest_share(cells, n_ranks, dim) * bytes_per_cell[dim - 2];
+        std::ostringstream what;
+        what.precision(3);
+        what << "about " << Memory::count(points) << " material points (" << bytes_per_point[dim - 2]
+             << " B each) and " << Memory::count(cells) << " grid cells (" << bytes_per_cell[dim - 2] << " B each)";
+        Memory::require_fits(comm, bytes, "MPM/Grid/Cell size", what.str(),
+                             "use a coarser MPM/Grid/Cell size, fewer Particles per cell, smaller bodies or more "
+                             "machines");
+      }
     } // namespace
 
 
@@ -403,6 +452,7 @@ namespace hysteron
         setup_from_checkpoint();
       else
         {
+          check_memory<dim>(scene, lower, upper, cell_size, n_cells);
           setup_grid();
           generate_particles();
           from_handler();

@@ -20,6 +20,7 @@
 #include <deal.II/base/mpi.h>
 
 #include <hysteron/base/exceptions.h>
+#include <hysteron/base/memory.h>
 #include <hysteron/rbsn/model.h>
 
 #include "rbsn/blocks.h"
@@ -141,10 +142,44 @@ namespace hysteron
         range << "d = " << spacing.min << " ... " << spacing.max;
       const std::string distance = range.str();
       const std::string integral = dim == 2 ? "0.68 int 1/d^2 dA" : "0.70 int 1/d^3 dV";
-      require(spacing.predicted_points <= 5e6,
-              "RBSN/Minimum distance",
-              "about " + std::to_string(static_cast<long>(spacing.predicted_points)) +
-                " points predicted at this minimum distance (" + integral + " over the bodies; at most 5e6)");
+      {
+        // The memory before the sampling: every rank its share of the cells with their
+        // facets (about 3 per cell in 2D, 7 in 3D), the tangent and an iterative solver
+        // (ML); the whole network on each rank with variable order. A direct factorization
+        // adds its fill where it is made (on one rank but for Mumps): 6.5 kB per cell in 2D,
+        // 6 kB n^(1/3) per cell in 3D (nested dissection: n^(4/3)). The constants are
+        // slopes of the peak RSS, rounded up: 6.1 kB per cell in 2D (2.7e4 ... 5.6e4 cells),
+        // 46 kB in 3D (7.7e3 ... 1.6e4 cells), linear static, CG + ML, measured by
+        //   benchmarks/memory_estimate.py --hysteron build/hysteron --only rbsn
+        // (each run /usr/bin/time -v hysteron scene.prm); the fill from the UMFPACK and CG
+        // runs of doc/benchmarks.md (2D 13.9 against 7.4 kB per cell at 1e5 cells; 3D 203 kB
+        // per cell at 2.1e4 cells, 117 kB at 3.8e3: 6 kB n^(1/3) over CG's 48 kB).
+        constexpr double   bytes_per_cell[2] = {6.5e3, 48e3};
+        const MPI_Comm     comm              = scene.mpi_communicator();
+        const unsigned int n_ranks           = dealii::Utilities::MPI::n_mpi_processes(comm);
+        const double       n                 = spacing.predicted_points;
+        const bool         whole             = analysis == Analysis::variable_order || n_ranks == 1;
+        double             bytes = (whole ? n : Memory::largest_share(n, n_ranks, dim)) * bytes_per_cell[dim - 2];
+        if (analysis != Analysis::variable_order && linear_solver == "direct")
+          {
+            const double fill = n * (dim == 2 ? 6.5e3 : 6e3 * std::cbrt(n));
+            if (whole || distributed_solver != "Amesos_Mumps")
+              bytes += dealii::Utilities::MPI::this_mpi_process(comm) == 0 ? fill : 0.0;
+            else
+              bytes += fill / n_ranks;
+          }
+        std::ostringstream what;
+        what.precision(3);
+        what << "about " << Memory::count(n) << " cells predicted at this minimum distance (" << integral
+             << " over the bodies), " << bytes_per_cell[dim - 2] << " B each with their facets"
+             << (linear_solver == "direct" && analysis != Analysis::variable_order ?
+                   " and the direct solver's fill" :
+                   "");
+        Memory::require_fits(comm, bytes, "RBSN/Minimum distance", what.str(),
+                             "use a larger RBSN/Minimum distance, smaller bodies" +
+                               std::string(linear_solver == "direct" ? ", RBSN/Linear solver = cg or gmres" : "") +
+                               " or more machines");
+      }
       StageReport stage(scene.console(), spacing.predicted_points > (dim == 2 ? 5e4 : 1e4));
       if (stage.enabled())
         scene.console() << "rbsn: about " << StageReport::count(static_cast<std::size_t>(spacing.predicted_points))
