@@ -438,7 +438,7 @@ namespace hysteron
       // The round-off the iterate carries, eps |K| |u| (a free flight: base/newton.h).
       const double floor = std::max(residual_floor(u.size()),
                                     iterate_floor(u.size(),
-                                                  distributed() ? parallel_matrix.linfty_norm() : matrix.linfty_norm(),
+                                                  trilinos_system() ? parallel_matrix.linfty_norm() : matrix.linfty_norm(),
                                                   u_trial.linfty_norm(),
                                                   force_level()));
       const unsigned int iterations = newton_iterate(problem, newton, floor);
