@@ -94,16 +94,43 @@ namespace hysteron
     {
       if (committed)
         return;
+      // The first failure's errno: a later call (close(), remove()) may overwrite it.
+      if (!out && error == 0)
+        error = errno;
       out.flush();
-      const bool good = static_cast<bool>(out);
+      if (!out && error == 0)
+        error = errno;
       out.close();
-      if (!good || std::rename(temporary_name.c_str(), final_name.c_str()) != 0)
+      if (!out && error == 0)
+        error = errno;
+      if (!out || error != 0 || std::rename(temporary_name.c_str(), final_name.c_str()) != 0)
         {
+          if (error == 0)
+            error = errno;
           std::remove(temporary_name.c_str());
-          throw RuntimeError("cannot write '" + final_name + "': " + std::strerror(errno));
+          throw RuntimeError("cannot write '" + final_name + "': " +
+                             (error != 0 ? std::strerror(error) : "an input/output error"));
         }
       committed = true;
       RunRecord::get().add_file(final_name);
+    }
+
+    void
+    AtomicFile::write(const std::function<void(std::ostream &)> &writer)
+    {
+      try
+        {
+          writer(out);
+        }
+      catch (const std::exception &)
+        {
+          // Only a failed stream is the file's error (commit() reports it); anything
+          // else is the writer's own and goes on.
+          if (out)
+            throw;
+          error = errno;
+        }
+      commit();
     }
 
     void
@@ -253,7 +280,13 @@ namespace hysteron
           if (n < 0 && errno == EINTR)
             continue;
           if (n <= 0)
-            throw RuntimeError("cannot write '" + name + "': " + std::strerror(errno));
+            {
+              // A full disk may have taken part of a row: back to the last whole one.
+              const int error = n < 0 ? errno : ENOSPC;
+              if (done > 0 && ::ftruncate(fd, written) == 0)
+                ::lseek(fd, written, SEEK_SET);
+              throw RuntimeError("cannot write '" + name + "': " + std::strerror(error));
+            }
           done += n;
         }
       written += buffer.size();
@@ -267,6 +300,30 @@ namespace hysteron
       if (::fsync(fd) != 0)
         throw RuntimeError("cannot write '" + name + "' to disk: " + std::strerror(errno));
     }
+
+    namespace
+    {
+      /// Run @p write where @p writes and make its RuntimeError every rank's (the first
+      /// failing rank's message): a rank that cannot write (a full disk) stops them all,
+      /// instead of leaving the others waiting in the next collective operation.
+      void
+      collectively(const MPI_Comm comm, const bool writes, const std::function<void()> &write)
+      {
+        std::string failure;
+        if (writes)
+          try
+            {
+              write();
+            }
+          catch (const RuntimeError &e)
+            {
+              failure = e.what();
+            }
+        for (const auto &f : dealii::Utilities::MPI::all_gather(comm, failure))
+          if (!f.empty())
+            throw RuntimeError(f);
+      }
+    } // namespace
 
     FieldWriter::FieldWriter(const std::string &directory,
                              const std::string &base_name,
@@ -307,48 +364,26 @@ namespace hysteron
       const unsigned int rank    = dealii::Utilities::MPI::this_mpi_process(comm);
       const std::string  stem    = base_name + "-" + dealii::Utilities::int_to_string(counter, 5);
 
-      std::string record;
-      if (n_ranks == 1)
-        {
-          record = stem + ".vtu";
-          AtomicFile file(directory + "/" + record);
-          piece(file.stream());
-          file.commit();
-        }
-      else
-        {
-          const std::string mine = stem + "." + dealii::Utilities::int_to_string(rank, 4) + ".vtu";
-          {
-            AtomicFile file(directory + "/" + mine);
-            piece(file.stream());
-            file.commit();
-          }
-          std::vector<std::string> pieces;
-          for (unsigned int r = 0; r < n_ranks; ++r)
-            pieces.push_back(stem + "." + dealii::Utilities::int_to_string(r, 4) + ".vtu");
-          record = stem + ".pvtu";
-          // Every piece must exist before the record that names it.
-          MPI_Barrier(comm);
-          if (rank == 0)
-            {
-              AtomicFile file(directory + "/" + record);
-              record_writer(file.stream(), pieces);
-              file.commit();
-            }
-        }
+      const std::string piece_name =
+        n_ranks == 1 ? stem + ".vtu" : stem + "." + dealii::Utilities::int_to_string(rank, 4) + ".vtu";
+      const std::string record = n_ranks == 1 ? piece_name : stem + ".pvtu";
+      collectively(comm, true, [&]() { AtomicFile(directory + "/" + piece_name).write(piece); });
 
+      // Every piece exists before the record that names it (collectively() waits for all).
       times_and_names.emplace_back(time, record);
-      if (rank == 0)
-        {
-          // The pieces of the other ranks belong to this run too.
-          if (n_ranks > 1)
+      collectively(comm, rank == 0, [&]() {
+        if (n_ranks > 1)
+          {
+            std::vector<std::string> pieces;
+            for (unsigned int r = 0; r < n_ranks; ++r)
+              pieces.push_back(stem + "." + dealii::Utilities::int_to_string(r, 4) + ".vtu");
+            AtomicFile(directory + "/" + record).write([&](std::ostream &out) { record_writer(out, pieces); });
+            // The pieces of the other ranks belong to this run too.
             for (unsigned int r = 1; r < n_ranks; ++r)
-              RunRecord::get().add_file(directory + "/" + stem + "." +
-                                        dealii::Utilities::int_to_string(r, 4) + ".vtu");
-          AtomicFile file(directory + "/" + base_name + ".pvd");
-          dealii::DataOutBase::write_pvd_record(file.stream(), times_and_names);
-          file.commit();
-        }
+              RunRecord::get().add_file(directory + "/" + pieces[r]);
+          }
+        write_pvd();
+      });
       ++counter;
     }
 
@@ -360,16 +395,18 @@ namespace hysteron
       const std::string record = base_name + "-" + dealii::Utilities::int_to_string(counter, 5) + ".vtu";
       times_and_names.emplace_back(time, record);
       ++counter;
-      if (dealii::Utilities::MPI::this_mpi_process(comm) != 0)
-        return;
-      {
-        AtomicFile file(directory + "/" + record);
-        writer(file.stream());
-        file.commit();
-      }
-      AtomicFile file(directory + "/" + base_name + ".pvd");
-      dealii::DataOutBase::write_pvd_record(file.stream(), times_and_names);
-      file.commit();
+      collectively(comm, dealii::Utilities::MPI::this_mpi_process(comm) == 0, [&]() {
+        AtomicFile(directory + "/" + record).write(writer);
+        write_pvd();
+      });
+    }
+
+    void
+    FieldWriter::write_pvd() const
+    {
+      AtomicFile(directory + "/" + base_name + ".pvd").write([&](std::ostream &out) {
+        dealii::DataOutBase::write_pvd_record(out, times_and_names);
+      });
     }
 
 

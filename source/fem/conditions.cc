@@ -60,10 +60,19 @@ namespace hysteron
       dirichlet.clear();
       wall_forces.clear();
       walls.clear();
-      std::map<dealii::types::global_dof_index, int> taken; // first set wins
+      // A DoF that two conditions select belongs to the first (its reaction); the two
+      // must prescribe the same motion there (ConditionOverlaps), else the scene is refused.
+      std::map<dealii::types::global_dof_index, int> taken;
+      ConditionOverlaps<dim> overlaps(scene.boundary_descriptions(), scene.time_control().end_time, "node of the fem mesh");
+      unsigned long selected = 0; // by the current condition, shared DoFs included
       const auto add = [&](DirichletSet &set, const dealii::types::global_dof_index dof, const unsigned int c, const int index) {
-        if (taken.count(dof))
-          return;
+        ++selected;
+        if (const auto first = taken.find(dof); first != taken.end())
+          {
+            if (set.rigid < 0 && dirichlet[first->second].rigid < 0)
+              overlaps.check(dirichlet[first->second].boundary, set.boundary, c, support[dof]);
+            return;
+          }
         taken[dof] = index;
         set.dofs.push_back(dof);
         set.components.push_back(c);
@@ -92,6 +101,7 @@ namespace hysteron
               continue;
             }
           const auto [lower, upper] = mesh_box.get_boundary_points();
+          selected                  = 0;
           if (!d.physical_group.empty())
             {
               // The nodes of a Gmsh group's faces or cells.
@@ -103,13 +113,14 @@ namespace hysteron
             for (const auto &[dof, p] : support)
               if (d.prescribes(p, component[dof], lower, upper, tolerance))
                 add(set, dof, component[dof], index);
-          const unsigned long n = dealii::Utilities::MPI::sum<unsigned long>(set.dofs.size(), scene.mpi_communicator());
+          const unsigned long n = dealii::Utilities::MPI::sum<unsigned long>(selected, scene.mpi_communicator());
           require(n > 0,
-                  "Boundary " + d.name + (!d.set.empty() ? "/Set" : d.has_region ? "/Region" : "/Faces"),
+                  d.where(),
                   "selects no node of the fem mesh (faces are those of the mesh's bounding "
                   "box; a region must contain mesh nodes)");
           dirichlet.push_back(std::move(set));
         }
+      overlaps.throw_if_any(scene.mpi_communicator());
       // Rigid bodies prescribe their motion on the mesh nodes inside them.
       for (unsigned int b = 0; b < bodies.size(); ++b)
         if (bodies[b].rigid)

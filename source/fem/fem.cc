@@ -23,6 +23,7 @@
 #include <iomanip>
 #include <limits>
 #include <iostream>
+#include <set>
 #include <sstream>
 
 namespace hysteron
@@ -372,6 +373,7 @@ namespace hysteron
       setup_history();
       setup_dirichlet();
       check_supports();
+      warn_about_locking();
       setup_loads();
       setup_probes();
       setup_set_histories();
@@ -416,6 +418,46 @@ namespace hysteron
     Solver<dim>::open_outputs()
     {
       open_tables();
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::warn_about_locking() const
+    {
+      // Fully integrated Q1 (without B-bar) and P1 (constant strain) constrain the
+      // dilatation at every Gauss point resp. cell. As nu -> 1/2 the bulk modulus outgrows
+      // the shear modulus, lambda / mu = 2 nu / (1 - 2 nu) (49 at nu = 0.49, 5,000 at
+      // 0.4999), and these constraints stiffen the mesh by a factor that grows with it
+      // (volumetric locking). Plane stress has no such constraint (eps_zz is free).
+      const Scene<dim> &scene = this->get_scene();
+      if (degree != 1 || (b_bar && !simplex))
+        return;
+      std::ostringstream materials;
+      std::set<std::string> seen;
+      double                worst = 0;
+      for (const auto &b : scene.body_descriptions())
+        {
+          const std::string name = b.material.empty() ? "Material" : "Material " + b.material;
+          if (b.rigid || !seen.insert(name).second)
+            continue;
+          const auto &el = scene.material(b.material, "Body " + b.name + "/Material").elasticity();
+          if ((dim == 2 && el.stress_state == Material::StressState::plane_stress) || !(el.poissons_ratio >= 0.49))
+            continue;
+          materials << (worst > 0 ? ", " : "") << name << " (Poisson's ratio " << el.poissons_ratio << ")";
+          worst = std::max(worst, el.poissons_ratio);
+        }
+      if (worst == 0 || !scene.is_root())
+        return;
+      std::cerr << "hysteron: warning: FEM: " << materials.str() << " is nearly incompressible (0.49 or more), and "
+                << (simplex ? "linear triangles / tetrahedra (P1)" : "bilinear / trilinear elements (Q1) without B-bar")
+                << " lock volumetrically: the mesh is too stiff by a factor that grows with lambda / mu = "
+                << 2 * worst / (1 - 2 * worst) << " (a Q1 plane-strain cantilever at 0.4999: 18 times). "
+                << (simplex                ? "B-bar cannot help P1: use FEM/Degree = 2." :
+                    scene.axisymmetric() ? "Use FEM/Degree = 2 (B-bar is not available in an axisymmetric scene)." :
+                                           "Use FEM/B-bar = true or FEM/Degree = 2.")
+                << std::endl;
     }
 
 

@@ -205,14 +205,14 @@ namespace hysteron
          [&](const unsigned int iteration, const double residual, const double alpha) {
            log_newton(t1, dt, iteration, residual, alpha);
          }});
-      // Updated Lagrangian: the strains are differences of gradients of the full motion, so
-      // their round-off is eps |grad x| and that of the forces about eps |K| (u_scale + |u|)
-      // even when the stresses vanish (a rigid rotation): the floor relative to the force level.
-      double floor = residual_floor();
-      if (finite_strain)
-        floor = std::max(floor,
-                         residual_floor() * system_matrix.linfty_norm() * (u_scale + u_trial.linfty_norm()) /
-                           force_level());
+      // The round-off of the residual that the iterate carries (base/newton.h): eps |K| |u|
+      // (a free flight: rigid motion, no force). Updated Lagrangian: the strains are
+      // differences of gradients of the full motion x = X + u, eps |K| (u_scale + |u|).
+      const double floor = std::max(residual_floor(),
+                                    iterate_floor(dof_handler.n_dofs(),
+                                                  system_matrix.linfty_norm(),
+                                                  (finite_strain ? u_scale : 0.0) + u_trial.linfty_norm(),
+                                                  force_level()));
       const unsigned int iterations = newton_iterate(problem, newton, floor);
       n_newton += iterations > 0 ? iterations : newton.max_iterations;
       return iterations > 0;

@@ -611,16 +611,8 @@ namespace hysteron
       c.lambda_eff   = el.effective_lambda();
       c.sigma_y0     = parameters.yield_stress;
       c.eps_y        = c.sigma_y0 / c.E;
-      // The law is a small-strain law: a yield strain of several per cent is
-      // usually a unit slip (E in MPa or GPa, the yield stress in Pa).
-      if (c.eps_y > 0.05)
-        {
-          std::ostringstream w;
-          w << Section(section, "Bouc-Wen").where("Yield stress") << ": the yield strain sigma_y / E = "
-            << c.eps_y << " (yield stress " << c.sigma_y0 << " Pa, Young's modulus " << c.E
-            << " Pa) is above 5 %, far outside the range of a small-strain law: check the units";
-          this->add_warning(w.str());
-        }
+      // (An implausible yield strain sigma_y / E is refused or warned about by the
+      // parameters, for every user of the law.)
       const double a = parameters.post_yield_ratio;
       const double m = parameters.isotropic_fraction;
       c.H            = a * c.E / (1.0 - a);

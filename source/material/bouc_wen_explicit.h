@@ -144,6 +144,11 @@ namespace hysteron
                   << " sub-steps for one strain increment (reached s = " << s << ", sub-step "
                   << h << ", H1 = " << H1_now
                   << "). Reduce the strain increment or raise Material/Bouc-Wen/Tolerance.";
+                // A unit slip (a yield stress in MPa with E in Pa) looks like this failure.
+                if (c.eps_y < 1e-7 || c.eps_y > 0.05)
+                  m << " The yield strain sigma_y / E = " << c.eps_y
+                    << " is far from that of structural materials (1e-5 to 1e-2): are the yield "
+                       "stress and Young's modulus both in Pa?";
                 throw RuntimeError(m.str());
               }
             const bool last = (s + h >= 1.0);

@@ -85,9 +85,32 @@ namespace hysteron
     BoucWenParameters::parse_parameters(const Section &material)
     {
       std::vector<std::string> warnings;
+      // (Read before the subsection is entered: a Section enters it in the handler.)
+      const double             E = material.get_positive("Young's modulus");
       Section                  s(material, "Bouc-Wen");
 
       yield_stress     = s.get_positive("Yield stress");
+      // The yield strain sigma_y / E of structural materials lies between about 1e-5
+      // (soft clays, concrete in tension) and a few per cent. Below 1e-7 it is most likely
+      // a unit slip (sigma_y in MPa with E in Pa), and the adaptive integrator would need
+      // about 1e7 sub-steps per strain increment of 1; above 5 % (E in MPa or GPa with
+      // sigma_y in Pa) the small-strain law is far outside its range. Both: a warning
+      // (a scaled, dimensionless model may mean it).
+      const double eps_y   = yield_stress / E;
+      const auto   numbers = [&]() {
+        std::ostringstream m;
+        m << "the yield strain sigma_y / E = " << eps_y << " (yield stress " << yield_stress
+          << " Pa, Young's modulus " << E << " Pa)";
+        return m.str();
+      };
+      if (eps_y < 1e-7)
+        warnings.push_back(s.where("Yield stress") + ": " + numbers() +
+                           " is below 1e-7, far below that of any structural material (steel about "
+                           "1e-3, concrete in tension 1e-4): a yield stress in MPa with Young's "
+                           "modulus in Pa? Both are in Pa (235 MPa is 235e6)");
+      if (eps_y > 0.05)
+        warnings.push_back(s.where("Yield stress") + ": " + numbers() +
+                           " is above 5 %, far outside the range of a small-strain law: check the units");
       post_yield_ratio = s.get_double("Post-yield stiffness ratio");
       require(post_yield_ratio >= 0 && post_yield_ratio < 1,
               s.where("Post-yield stiffness ratio"),

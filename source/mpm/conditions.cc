@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 namespace hysteron
@@ -53,11 +54,50 @@ namespace hysteron
             grid->mpi_communicator());
           // A condition acts on grid nodes: one that selects none acts on nothing.
           require(n_nodes > 0,
-                  "Boundary " + description.name + (description.has_region ? "/Region" : "/Faces"),
+                  description.where(),
                   "selects no grid node (the background grid is " + grid_extent(grid->lattice()) + ")");
           boundaries.push_back(std::move(b));
         }
+      refuse_conflicting_boundaries();
       boundary_acted.assign(boundaries.size(), false);
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::refuse_conflicting_boundaries() const
+    {
+      // The conditions that prescribe each component of a node, in the order of the scene:
+      // a later one must prescribe the same motion as the first (ConditionOverlaps), so that
+      // the order in which apply_boundary_conditions() imposes them does not matter.
+      using Type              = typename BoundaryDescription<dim>::Type;
+      const Scene<dim> &scene = this->get_scene();
+      ConditionOverlaps<dim> overlaps(scene.boundary_descriptions(), scene.time_control().end_time, "grid node");
+      std::map<unsigned int, std::array<int, dim>> first;
+      for (unsigned int b = 0; b < boundaries.size(); ++b)
+        for (unsigned int k = 0; k < boundaries[b].nodes.size(); ++k)
+          {
+            const auto        &bc   = boundaries[b];
+            const Type         type = static_cast<Type>(bc.type);
+            const unsigned int n    = bc.nodes[k];
+            auto [entry, added]     = first.try_emplace(n);
+            if (added)
+              entry->second.fill(-1);
+            for (unsigned int c = 0; c < dim; ++c)
+              {
+                const bool prescribed = type == Type::fixed || (type == Type::roller && c == bc.normal_direction[k]) ||
+                                        ((type == Type::velocity || type == Type::displacement) && bc.components[c]);
+                if (!prescribed)
+                  continue;
+                int &owner = entry->second[c];
+                if (owner < 0)
+                  owner = b;
+                else
+                  overlaps.check(owner, b, c, grid->node_position(n));
+              }
+          }
+      overlaps.throw_if_any(grid->mpi_communicator());
     }
 
 

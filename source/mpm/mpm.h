@@ -220,6 +220,9 @@ namespace hysteron
       generate_particles();
       void
       setup_boundaries();
+      /// Refuse two conditions that prescribe one component of a grid node differently.
+      void
+      refuse_conflicting_boundaries() const;
       /// --resume: the grid and this rank's points (in resumed_points) from the checkpoint.
       void
       setup_from_checkpoint();

@@ -571,11 +571,32 @@ namespace hysteron
         }
       dof_set.assign(n_dofs * n_local, -1);
       dirichlet.clear();
+      // A DoF that two conditions select belongs to the first (its reaction); the two must
+      // prescribe the same motion there (ConditionOverlaps), else the scene is refused.
+      ConditionOverlaps<dim> overlaps(scene.boundary_descriptions(), scene.time_control().end_time, "cell of the network (its nucleus)");
+      bool selects_owned = false; // the current condition selects an owned cell
       const auto take = [&](Dirichlet &set, const unsigned int dof) {
+        selects_owned = selects_owned || dof < n_dofs * n_owned_cells;
         if (dof_set[dof] < 0)
           {
             dof_set[dof] = dirichlet.size();
             set.dofs.push_back(dof);
+          }
+        else if (const Dirichlet &first = dirichlet[dof_set[dof]]; first.boundary >= 0 && set.boundary >= 0)
+          {
+            // The same DoF's history under either condition (prescribed_increment() reads
+            // only the set's boundary), translations and rotations alike.
+            const unsigned int k = dof % n_dofs;
+            static const char *axes[3] = {"x", "y", "z"};
+            const std::string  name = k < dim ? std::string(axes[k]) :
+                                      dim == 2 ? std::string("rotation") :
+                                                 "rotation about " + std::string(axes[k - dim]);
+            overlaps.check(first.boundary,
+                           set.boundary,
+                           name,
+                           nucleus(dof / n_dofs),
+                           [&](const double t) { return prescribed_increment(first, dof, 0, t); },
+                           [&](const double t) { return prescribed_increment(set, dof, 0, t); });
           }
       };
       // The translations by the boundary's rule; the rotations with all of them (fixed,
@@ -585,8 +606,9 @@ namespace hysteron
         {
           const auto &d = scene.boundary_descriptions()[b];
           Dirichlet   set;
-          set.name     = d.name;
-          set.boundary = b;
+          set.name      = d.name;
+          set.boundary  = b;
+          selects_owned = false;
           for (unsigned int c = 0; c < n_local; ++c)
             {
               const auto &x   = nucleus(c);
@@ -600,27 +622,25 @@ namespace hysteron
                 for (unsigned int k = dim; k < n_dofs; ++k)
                   take(set, n_dofs * c + k);
             }
-          const bool owns = std::any_of(set.dofs.begin(), set.dofs.end(),
-                                        [&](const unsigned int i) { return i < n_dofs * n_owned_cells; });
-          require(count(owns ? 1 : 0) > 0,
-                  "Boundary " + d.name + (!d.set.empty() ? "/Set" : d.has_region ? "/Region" : "/Faces"),
+          require(count(selects_owned ? 1 : 0) > 0,
+                  d.where(),
                   "selects no cell of the network (a cell is selected by its nucleus: on the face "
                   "of the nuclei's bounding box, or in the region)");
           dirichlet.push_back(std::move(set));
         }
+      overlaps.throw_if_any(comm);
       for (unsigned int b = 0; b < bodies.size(); ++b)
         if (bodies[b].rigid)
           {
             Dirichlet set;
-            set.name  = bodies[b].name;
-            set.rigid = b;
+            set.name      = bodies[b].name;
+            set.rigid     = b;
+            selects_owned = false;
             for (unsigned int c = 0; c < n_local; ++c)
               if (bodies[b].shape.contains(nucleus(c), tolerance))
                 for (unsigned int k = 0; k < n_dofs; ++k)
                   take(set, n_dofs * c + k);
-            const bool owns = std::any_of(set.dofs.begin(), set.dofs.end(),
-                                          [&](const unsigned int i) { return i < n_dofs * n_owned_cells; });
-            require(count(owns ? 1 : 0) > 0,
+            require(count(selects_owned ? 1 : 0) > 0,
                     "Body " + bodies[b].name + "/Shape",
                     "the rigid body holds no nucleus of the network (it moves the cells whose "
                     "nuclei lie in its shape)");

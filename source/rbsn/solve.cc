@@ -435,7 +435,12 @@ namespace hysteron
                                              constraints.distribute(x);
                                            },
                                            log});
-      const double       floor      = residual_floor(u.size());
+      // The round-off the iterate carries, eps |K| |u| (a free flight: base/newton.h).
+      const double floor = std::max(residual_floor(u.size()),
+                                    iterate_floor(u.size(),
+                                                  trilinos_system() ? parallel_matrix.linfty_norm() : matrix.linfty_norm(),
+                                                  u_trial.linfty_norm(),
+                                                  force_level()));
       const unsigned int iterations = newton_iterate(problem, newton, floor);
       n_newton += iterations > 0 ? iterations : newton.max_iterations;
       u_trial.update_ghost_values();

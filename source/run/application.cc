@@ -11,6 +11,7 @@
 #include <hysteron/run/run_scene.h>
 #include <hysteron/scene/scene.h>
 
+#include "run/output_directory.h"
 #include "run/parameter_file.h"
 
 #include <algorithm>
@@ -28,6 +29,7 @@ namespace hysteron
     const char *usage_text =
       "Usage: hysteron [--quiet] [--compare] [--resume] SCENE.prm\n"
       "       hysteron --print-parameters [prm|json|markdown] [SCENE.prm]\n"
+      "       hysteron --status DIRECTORY\n"
       "       hysteron --help | --version\n"
       "\n"
       "Runs the scene described by the parameter file SCENE.prm: its `Dimension` (2 or 3) and\n"
@@ -43,6 +45,10 @@ namespace hysteron
       "  --print-parameters   write every parameter with its default, allowed values and\n"
       "                       documentation (PRM, JSON or Markdown) and exit; with SCENE.prm,\n"
       "                       the values of that file and its named materials\n"
+      "  --status DIRECTORY   the state of the run in the output directory DIRECTORY:\n"
+      "                       running (and by which process), finished, failed or\n"
+      "                       interrupted (also a run that was killed: its manifest still\n"
+      "                       says running, but no process holds the directory's lock)\n"
       "  --help               this text\n"
       "  --version            the version\n"
       "\n"
@@ -177,6 +183,15 @@ namespace hysteron
             {
               if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
                 std::cout << "hysteron " HYSTERON_VERSION " (deal.II " DEAL_II_PACKAGE_VERSION ")\n";
+              return 0;
+            }
+          else if (arg == "--status")
+            {
+              if (i + 1 >= argc)
+                throw InputError("command line", "--status needs the output directory of a run");
+              const std::string state = Run::OutputDirectory::describe(argv[i + 1]);
+              if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+                std::cout << state << std::endl;
               return 0;
             }
           else if (arg == "--quiet" || arg == "-q")

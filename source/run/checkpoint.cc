@@ -663,7 +663,7 @@ namespace hysteron
             info << text.str() << "end " << hex(text_crc(text.str())) << "\n";
             info.close();
             if (!info)
-              problem = "cannot write '" + (temporary / "info.txt").string() + "'";
+              problem = "cannot write '" + (temporary / "info.txt").string() + "': " + std::strerror(errno);
           }
           // Everything on disk before the rename publishes it.
           for (const auto &f : file.files)
@@ -678,6 +678,8 @@ namespace hysteron
                 problem = "cannot rename '" + temporary.string() + "': " + ec.message();
               sync_path(directory, true);
             }
+          else
+            fs::remove_all(temporary, ec); // nothing incomplete stays
           if (problem.empty())
             {
               auto &record = Output::RunRecord::get();

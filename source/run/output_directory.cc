@@ -14,6 +14,7 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <sys/file.h>
 #include <unistd.h>
@@ -219,6 +220,41 @@ namespace hysteron
       problem = dealii::Utilities::MPI::broadcast(comm, problem, 0);
       if (!problem.empty())
         throw InputError("Output/Directory", problem);
+    }
+
+    std::string
+    OutputDirectory::describe(const std::string &directory)
+    {
+      std::ifstream in(directory + "/" + manifest_name);
+      if (!in)
+        throw InputError("command line",
+                         "'" + directory + "' holds no " + manifest_name + " (not an output directory of hysteron)");
+      // The manifest's own lines (write_manifest()): "  \"key\": value,".
+      std::map<std::string, std::string> field;
+      std::string                        line;
+      while (std::getline(in, line))
+        for (const char *key : {"status", "message", "pid", "host", "started", "command"})
+          {
+            const std::string prefix = "  \"" + std::string(key) + "\": ";
+            if (line.rfind(prefix, 0) == 0)
+              {
+                std::string value = line.substr(prefix.size());
+                if (!value.empty() && value.back() == ',')
+                  value.pop_back();
+                field[key] = !value.empty() && value[0] == '"' ? unquote(value) : value;
+              }
+          }
+      const std::string status = field["status"];
+      if (status != "running")
+        return status + (field["message"].empty() ? "" : ": " + field["message"]);
+      if (const std::string holder = lock_holder(directory); !holder.empty())
+        return "running: " + holder.substr(0, holder.find('\n'));
+      return "interrupted: the manifest says running, but no process holds the lock of the directory: "
+             "the run (hysteron process " +
+             field["pid"] + " on " + field["host"] + " since " + field["started"] +
+             ") was killed before it could record its end (SIGKILL, a lost MPI rank or node). Its tables "
+             "hold whole rows and its files are complete; hysteron --resume continues it from its newest "
+             "checkpoint";
     }
 
     void

@@ -40,6 +40,16 @@ namespace hysteron
       static void
       check_usable(const std::string &directory, MPI_Comm comm);
 
+      /**
+       * `hysteron --status DIR`: the state of the run in @p directory from its manifest. A
+       * manifest says "running" from the start to the end of a run; a run killed in between
+       * (SIGKILL, a lost MPI rank or node) cannot change it, but its lock went with it: a
+       * manifest that says "running" while nobody holds the lock is reported as interrupted.
+       * Throws InputError if @p directory holds no manifest.
+       */
+      static std::string
+      describe(const std::string &directory);
+
       /// After set-up: create, lock, clean (a new run) and start the manifest.
       void
       open(const std::string &directory, const RunDescription &run, bool resume, MPI_Comm comm);

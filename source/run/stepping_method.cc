@@ -16,6 +16,7 @@
 #include <fstream>
 #include <iomanip>
 #include <sstream>
+#include <vector>
 
 namespace hysteron
 {
@@ -65,25 +66,42 @@ namespace hysteron
     std::string
     SteppingMethod<dim>::check_size()
     {
-      const double end = this->get_scene().time_control().end_time;
-      double       dt  = 0;
-      try
+      const auto  &time = this->get_scene().time_control();
+      const double end  = time.end_time;
+      // The steps of each phase of Time/Steps (one phase without it): its length over the
+      // step proposed at its start, so that a short first phase (1e-9: 1) is not taken for
+      // the step of the whole run.
+      std::vector<double> phase_ends;
+      for (const auto &[phase_end, n] : time.steps)
+        phase_ends.push_back(phase_end);
+      if (phase_ends.empty() || phase_ends.back() < end)
+        phase_ends.push_back(end);
+      double steps = 0, dt = 0, start = 0;
+      for (const double phase_end : phase_ends)
         {
-          dt = propose_step(0);
+          double phase_dt = 0;
+          try
+            {
+              phase_dt = propose_step(start);
+            }
+          catch (const StepFailure &)
+            {
+              return ""; // the first step reports it, with the last good state
+            }
+          if (!(phase_dt > 0))
+            return "";
+          if (dt == 0)
+            dt = phase_dt;
+          steps += std::ceil((phase_end - start) / phase_dt * (1 - 1e-12));
+          start = phase_end;
         }
-      catch (const StepFailure &)
-        {
-          return ""; // the first step reports it, with the last good state
-        }
-      if (!(dt > 0))
-        return "";
-      const double       steps = std::ceil(end / dt);
       const double       size  = size_of_state();
       std::ostringstream m;
       m.precision(3);
       if (steps > 1e9)
         m << label() << ": Time/End time = " << end << " s at a first step of " << dt << " s is "
-          << steps << " steps (more than 1e9): the run would not end. Shorten the End time or "
+          << steps << " steps" << (phase_ends.size() > 1 ? " (in all phases of Time/Steps)" : "")
+          << " (more than 1e9): the run would not end. Shorten the End time or "
           << "enlarge the step (Time/Time step, CFL factor, the number of increments).";
       else if (size > 0 && steps * size > 1e14)
         m << label() << ": " << steps << " steps of " << size << " unknowns (points or DoFs) are "

@@ -156,6 +156,21 @@ namespace hysteron
     return 64 * std::numeric_limits<double>::epsilon() * std::sqrt(n_dofs);
   }
 
+  /**
+   * The round-off floor of a residual r = K u - f that stems from the iterate u itself,
+   * relative to @p force_level: |fl(r_i) - r_i| <= eps sum_j |K_ij| |u_j| <= eps |K| |u|
+   * (row-sum norm, max norm), whatever the forces themselves. It matters when large terms
+   * cancel: a free flight (u a rigid motion, no strain, no acceleration: the inertia
+   * M (u - u_n - dt v_n) / (beta dt^2) of K_eff = K + M / (beta dt^2) and the internal
+   * forces are differences of large numbers), where the external force level is zero.
+   * With the factor 64 sqrt(N) of residual_floor(); 0 without a force level.
+   */
+  inline double
+  iterate_floor(const double n_dofs, const double matrix_norm, const double u_norm, const double force_level)
+  {
+    return force_level > 0 ? residual_floor(n_dofs) * matrix_norm * u_norm / force_level : 0.0;
+  }
+
   /// The columns of newton.csv (FEM and RBSN).
   inline std::vector<std::string>
   newton_columns()

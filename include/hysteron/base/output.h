@@ -64,6 +64,14 @@ namespace hysteron
       void
       commit();
 
+      /**
+       * Write the content with @p writer into stream() and commit(). A writer that stops
+       * on a failed stream (deal.II's VTU writers throw ExcIO; a full disk) is reported
+       * as the RuntimeError of commit(): the file and the system's reason (strerror).
+       */
+      void
+      write(const std::function<void(std::ostream &)> &writer);
+
       const std::string &
       filename() const
       {
@@ -75,6 +83,7 @@ namespace hysteron
       std::string   temporary_name;
       std::ofstream out;
       bool          committed = false;
+      int           error     = 0; ///< errno when the writer stopped on a failed stream
     };
 
     /// Write @p content to @p filename atomically.
@@ -209,6 +218,8 @@ namespace hysteron
        * @p piece writes "<base>-<step>.vtu"; on several, every rank writes its piece
        * "<base>-<step>.<rank>.vtu" and rank 0 the record "<base>-<step>.pvtu" with
        * @p record (given the pieces' names). Then the PVD. write() is this with DataOut.
+       * A write that fails on any rank is a RuntimeError on every rank (as in
+       * write_serial()).
        */
       void
       write_pieces(const std::function<void(std::ostream &)>                                   &piece,
@@ -231,6 +242,10 @@ namespace hysteron
       }
 
     private:
+      /// Rank 0: "<base>.pvd" with the records so far.
+      void
+      write_pvd() const;
+
       std::string                                 directory;
       std::string                                 base_name;
       MPI_Comm                                    comm;

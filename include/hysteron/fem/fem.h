@@ -311,6 +311,9 @@ namespace hysteron
       /// Quasi-static: refuse a mesh part whose rigid-body motions are free (supports.cc).
       void
       check_supports() const;
+      /// Warn (once) when Q1 without B-bar or P1 meets a nearly incompressible material.
+      void
+      warn_about_locking() const;
       void
       setup_loads();
       void

@@ -55,8 +55,9 @@ namespace hysteron
       static void
       declare_parameters(dealii::ParameterHandler &prm);
 
-      /// Read and validate from @p material (the `Material` section); returns warnings
-      /// (beta + gamma != 1, n < 1) for the caller to print.
+      /// Read and validate from @p material (the `Material` section); returns warnings (a
+      /// yield strain sigma_y / E below 1e-7 or above 5 %: units?, beta + gamma != 1,
+      /// n < 1) for the caller to print.
       std::vector<std::string>
       parse_parameters(const Section &material);
     };

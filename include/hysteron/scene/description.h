@@ -2,6 +2,7 @@
 #define hysteron_scene_description_h
 
 #include <deal.II/base/function_parser.h>
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/point.h>
 #include <deal.II/base/tensor.h>
@@ -10,9 +11,11 @@
 #include <hysteron/geometry/region.h>
 #include <hysteron/scene/amplitude.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace hysteron
@@ -177,6 +180,66 @@ namespace hysteron
     /// "x-", "y+", ... for face f.
     static std::string
     face_name(const unsigned int face);
+
+    /// The entry that selects the condition's nodes, for messages: "Boundary <name>/Set",
+    /// ".../Region" or ".../Faces".
+    std::string
+    where() const;
+
+    /// "fixed", "roller", "wall", "velocity" or "displacement".
+    std::string
+    type_name() const;
+  };
+
+  /**
+   * Conditions that meet, one rule for every method: two boundary conditions may prescribe
+   * the same component at the same node (a DoF of the FEM mesh, a cell of the RBSN, a node
+   * of the MPM grid) only if they prescribe the same motion there -- the same displacement
+   * since t = 0 at 100 times of the run (t_k = k T / 100), to 1e-9 of its size -- such as
+   * two fixed conditions that share an edge. Otherwise the scene is refused (an InputError
+   * at the later condition's entry, naming both conditions, the node, the component and
+   * what each prescribes), never resolved by the order of the subsections. A method
+   * records each pair that meets with check() and calls throw_if_any() (collective) once.
+   */
+  template <int dim>
+  class ConditionOverlaps
+  {
+  public:
+    /// @p node: what the method's nodes are called in messages ("node of the fem mesh").
+    ConditionOverlaps(const std::vector<BoundaryDescription<dim>> &conditions,
+                      const double                                 end_time,
+                      const std::string                           &node);
+
+    /**
+     * Condition @p a (listed before @p b) and condition @p b both prescribe @p component
+     * ("x", "rotation", ...) of the node at @p x; @p g_a and @p g_b give each one's
+     * displacement from 0 to t. Two conditions whose motions do not depend on the
+     * position (fixed, roller, velocity) are compared once per component.
+     */
+    void
+    check(const unsigned int                  a,
+          const unsigned int                  b,
+          const std::string                  &component,
+          const dealii::Point<dim>           &x,
+          const std::function<double(double)> &g_a,
+          const std::function<double(double)> &g_b);
+
+    /// check() of the translation @p c, the histories from displacement_increment().
+    void
+    check(const unsigned int a, const unsigned int b, const unsigned int c, const dealii::Point<dim> &x);
+
+    /// Collective: throw the InputError of the first disagreement (the lowest rank's)
+    /// on every rank; nothing if the conditions agree wherever they meet.
+    void
+    throw_if_any(const MPI_Comm comm) const;
+
+  private:
+    const std::vector<BoundaryDescription<dim>> &conditions;
+    double                                       end_time;
+    std::string                                  node;
+    /// (a, b, component) of position-independent pairs already compared.
+    std::map<std::tuple<unsigned int, unsigned int, std::string>, bool> compared;
+    std::string                                                        where, problem;
   };
 
   /**
