@@ -6,7 +6,8 @@ Two scenes at growing cell counts, each run --repeats times (median), pinned to 
 (1) Elastic plate (benchmarks/rbsn/plate_uniaxial.prm): 2 m x 0.5 m, k_t = k_n, nu = 0, rollers
     and an end displacement; the exact solution is the uniform strain eps = 5e-4. One static
     solve and the VTU output. Error: the reaction against E eps t H = 5 kN (the network's
-    solution is exact but for the cells that reach the loaded face between two boundary nuclei);
+    solution is exact but for the boundary cells, whose rotations the rollers and the end leave
+    free: a support acts at the nucleus, not at the centroid of the cell's boundary piece);
     second value: the largest |u_x - eps x| at four probe points against eps L (a probe reads the
     rigid motion of its cell: the O(d_m) error of piecewise-rigid cells). Target: 100,000 cells
     in under 20 s.
