@@ -11,6 +11,7 @@
 #include <hysteron/fem/fem.h>
 
 #include "run/keyed_records.h"
+#include "run/rank_parts.h"
 
 #include <sstream>
 
@@ -113,28 +114,9 @@ namespace hysteron
         serialize_rank(rank_parts[0]);
       else
         {
-          // Another number of ranks: rank 0 carries the sums of all the ranks' parts.
-          const bool root  = this->get_scene().is_root();
-          double     sums[3] = {0, 0, 0};
-          auto       walls   = wall_forces;
-          for (auto &w : walls)
-            w = 0;
-          for (auto &part : rank_parts)
-            {
-              serialize_rank(part);
-              sums[0] += internal_work;
-              sums[1] += external_work;
-              sums[2] += boundary_work;
-              for (std::size_t i = 0; i < walls.size() && i < wall_forces.size(); ++i)
-                walls[i] += wall_forces[i];
-            }
-          internal_work = root ? sums[0] : 0.0;
-          external_work = root ? sums[1] : 0.0;
-          boundary_work = root ? sums[2] : 0.0;
-          wall_forces   = walls;
-          if (!root)
-            for (auto &w : wall_forces)
-              w = 0;
+          Run::sum_rank_parts(rank_parts, this->get_scene().is_root(),
+                              [this](CheckpointReader &part) { serialize_rank(part); },
+                              internal_work, external_work, boundary_work, wall_forces);
         }
 
       const unsigned int                   level = triangulation->n_global_levels() - 1;

@@ -10,6 +10,7 @@
 // are first balanced again by their points, the arrays sorted afresh and the partial
 // sums gathered on rank 0: the run agrees with the uninterrupted one to round-off.
 #include "mpm/mpm.h"
+#include "run/rank_parts.h"
 
 #include <algorithm>
 #include <cmath>
@@ -347,28 +348,9 @@ namespace hysteron
         serialize_rank(rank_parts[0]);
       else
         {
-          // Another number of ranks: rank 0 carries the sums of all the ranks' parts.
-          const bool root   = this->get_scene().is_root();
-          double     sums[3] = {0, 0, 0};
-          auto       total   = reactions;
-          for (auto &r : total)
-            r = 0;
-          for (auto &part : rank_parts)
-            {
-              serialize_rank(part);
-              sums[0] += internal_work;
-              sums[1] += external_work;
-              sums[2] += boundary_work;
-              for (std::size_t i = 0; i < total.size() && i < reactions.size(); ++i)
-                total[i] += reactions[i];
-            }
-          internal_work   = root ? sums[0] : 0.0;
-          external_work   = root ? sums[1] : 0.0;
-          boundary_work   = root ? sums[2] : 0.0;
-          reactions       = total;
-          if (!root)
-            for (auto &r : reactions)
-              r = 0;
+          Run::sum_rank_parts(rank_parts, this->get_scene().is_root(),
+                              [this](CheckpointReader &part) { serialize_rank(part); },
+                              internal_work, external_work, boundary_work, reactions);
           n_changed_cells = 0;
         }
       restore_points(directory.same_ranks());
