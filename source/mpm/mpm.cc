@@ -447,12 +447,13 @@ namespace hysteron
       reactions.assign(scene.boundary_descriptions().size() + scene.body_descriptions().size(),
                        dealii::Tensor<1, dim>());
       // The grid and the points: new, or from the checkpoint of --resume (the points go
-      // into the arrays in load(), once the grid is where it was).
+      // into the arrays in load(), once the grid is where it was). The memory is checked
+      // either way: a resume on fewer ranks gives each rank more of the points.
+      check_memory<dim>(scene, lower, upper, cell_size, n_cells);
       if (this->resuming())
         setup_from_checkpoint();
       else
         {
-          check_memory<dim>(scene, lower, upper, cell_size, n_cells);
           setup_grid();
           generate_particles();
           from_handler();

@@ -15,12 +15,14 @@
 #include "run/parameter_file.h"
 
 #include <algorithm>
+#include <chrono>
 #include <dlfcn.h>
 #include <filesystem>
 #include <memory>
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <thread>
 
 namespace hysteron
 {
@@ -270,53 +272,88 @@ namespace hysteron
       return 0;
     }
 
-    void
-    report(const std::string &kind, const std::string &message)
+    /// Whether every rank ended with an error within @p seconds: a non-blocking barrier
+    /// on a communicator of its own, which no other operation uses. An error found
+    /// collectively (bad input, a failure shared by collectively()) reaches every rank at
+    /// about the same time; one that only some ranks found (a table the root cannot
+    /// write) leaves the others in their next collective operation, where they would wait
+    /// forever.
+    bool
+    every_rank_failed(const MPI_Comm comm, const double seconds)
     {
-      // Every rank sees the same error; one message is enough.
-      if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
-        std::cerr << "hysteron: " << kind << ": " << message << std::endl;
+      MPI_Request request;
+      MPI_Ibarrier(comm, &request);
+      const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+      int        done  = 0;
+      while (MPI_Test(&request, &done, MPI_STATUS_IGNORE) == MPI_SUCCESS && done == 0)
+        {
+          if (std::chrono::steady_clock::now() > until)
+            return false;
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+      return done != 0;
+    }
+
+    /// The end of a run with an error: the message once, and @p status. On several ranks,
+    /// an error of some ranks only stops all of them (MPI_Abort with @p status) with the
+    /// message of the rank that found it, instead of leaving the others waiting.
+    int
+    fail(const MPI_Comm errors, const int status, const std::string &kind, const std::string &message)
+    {
+      const unsigned int n_ranks = dealii::Utilities::MPI::n_mpi_processes(errors);
+      const unsigned int rank    = dealii::Utilities::MPI::this_mpi_process(errors);
+      if (n_ranks == 1 || every_rank_failed(errors, 10))
+        {
+          // Every rank has the same message; one is enough.
+          if (rank == 0)
+            std::cerr << "hysteron: " << kind << ": " << message << std::endl;
+          return status;
+        }
+      std::cerr << "hysteron: " << kind << " on MPI rank " << rank << " of " << n_ranks << ": " << message
+                << " (the other ranks did not meet this error and are stopped)" << std::endl;
+      MPI_Abort(MPI_COMM_WORLD, status);
+      return status;
     }
   } // namespace
 
   int
   run_application(int argc, char **argv)
   {
+    // The communicator of the error handshake (fail()), made while every rank is here.
+    MPI_Comm errors;
+    MPI_Comm_dup(MPI_COMM_WORLD, &errors);
+    int status = 0;
     try
       {
-        return run(argc, argv);
+        status = run(argc, argv);
       }
     catch (const InputError &e)
       {
-        report("error", e.what());
-        return 1;
+        return fail(errors, 1, "error", e.what());
       }
     catch (const RuntimeError &e)
       {
-        report("run-time error", e.what());
-        return 2;
+        return fail(errors, 2, "run-time error", e.what());
       }
     catch (const NonFiniteExpression &e)
       {
         // Found during the run (between the times checked up front): the tables
         // hold every step before it.
-        report("run-time error", e.what());
-        return 2;
+        return fail(errors, 2, "run-time error", e.what());
       }
     catch (const Interrupted &e)
       {
-        report("interrupted", e.what());
-        return 4;
+        return fail(errors, 4, "interrupted", e.what());
       }
     catch (const dealii::ExceptionBase &e)
       {
-        report("internal error", one_line(e));
-        return 3;
+        return fail(errors, 3, "internal error", one_line(e));
       }
     catch (const std::exception &e)
       {
-        report("internal error", e.what());
-        return 3;
+        return fail(errors, 3, "internal error", e.what());
       }
+    MPI_Comm_free(&errors);
+    return status;
   }
 } // namespace hysteron

@@ -2,11 +2,13 @@
 """A write that fails (a full disk) is a run-time error that names the file and the system's
 reason, for every writer: the FEM's, the MPM's and the RBSN's VTU (the second output: a
 symbolic link <name>.tmp -> /dev/full makes the atomic write of <name> fail with ENOSPC) and a
-time table (its header). Asserted: exit status 2, "cannot write '<name>': No space left on
+time table (its header), the table also on 2 MPI ranks, where only the root writes tables: its
+error must stop the other rank too (which would otherwise wait in its next collective
+operation forever). Asserted: exit status 2, "cannot write '<name>': No space left on
 device" on stderr, no file under the final name and no *.tmp left; the first VTU (the last
 good state) stays complete.
 
-Usage: write_failure.py HYSTERON WORKDIR
+Usage: write_failure.py HYSTERON WORKDIR [MPIEXEC]
 """
 import os
 import re
@@ -15,6 +17,9 @@ import subprocess
 import sys
 
 hysteron, work = sys.argv[1:3]
+mpiexec = sys.argv[3] if len(sys.argv) > 3 else None
+mpi_env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1")
 here = os.path.dirname(os.path.abspath(__file__))
 tests = os.path.dirname(here)
 shutil.rmtree(work, ignore_errors=True)
@@ -42,13 +47,23 @@ cases = [
     ("table", scene("fem/vibrating_bar_implicit.prm", [("End time = 0.8", "End time = 0.04")]),
      "probe_0.csv"),
 ]
+if mpiexec:
+    cases.append(("table on 2 ranks", cases[-1][1], "probe_0.csv"))
 for label, text, name in cases:
-    run = os.path.join(work, label)
+    run = os.path.join(work, label.replace(" ", "_"))
     os.makedirs(os.path.join(run, "output"))
     with open(os.path.join(run, "scene.prm"), "w") as f:
         f.write(text)
     os.symlink("/dev/full", os.path.join(run, "output", name + ".tmp"))
-    p = subprocess.run([hysteron, "--quiet", "scene.prm"], cwd=run, capture_output=True, text=True)
+    command = [hysteron, "--quiet", "scene.prm"]
+    if label.endswith("2 ranks"):
+        command = [mpiexec, "-np", "2"] + command
+    try:
+        p = subprocess.run(command, cwd=run, capture_output=True, text=True, timeout=120,
+                           env=mpi_env)
+    except subprocess.TimeoutExpired:
+        failures.append(f"{label}: no end within 120 s (a rank waits for the one that failed)")
+        continue
     left = sorted(os.listdir(os.path.join(run, "output")))
     if p.returncode != 2:
         failures.append(f"{label}: exit {p.returncode}, not 2: {p.stderr[-1500:]}")
