@@ -43,7 +43,7 @@ namespace hysteron
       "                       and fem) and compare their tables (= set Method = compare)\n"
       "  --resume             continue the run of SCENE.prm from the newest checkpoint in\n"
       "                       its output directory (subsection Checkpoint; a run stopped by\n"
-      "                       SIGINT or SIGTERM writes one), with as many MPI ranks as before\n"
+      "                       SIGINT or SIGTERM writes one), on any number of MPI ranks\n"
       "  --print-parameters   write every parameter with its default, allowed values and\n"
       "                       documentation (PRM, JSON or Markdown) and exit; with SCENE.prm,\n"
       "                       the values of that file and its named materials\n"

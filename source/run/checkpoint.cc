@@ -681,24 +681,30 @@ namespace hysteron
           else
             fs::remove_all(temporary, ec); // nothing incomplete stays
           if (problem.empty())
-            {
-              auto &record = Output::RunRecord::get();
-              record.add_directory(final_dir.string());
-              // Keep the newest `keep`.
-              std::vector<std::pair<long, fs::path>> existing;
-              for (const auto &entry : fs::directory_iterator(directory, ec))
-                {
-                  const long s = step_of(entry.path().filename().string());
-                  if (s >= 0 && entry.is_directory(ec))
-                    existing.emplace_back(s, entry.path());
-                }
-              std::sort(existing.begin(), existing.end());
-              for (std::size_t i = 0; i + keep < existing.size(); ++i)
-                {
-                  fs::remove_all(existing[i].second, ec);
-                  record.remove(existing[i].second.string());
-                }
-            }
+            try
+              {
+                // The manifest lists the checkpoint (its write may fail too).
+                auto &record = Output::RunRecord::get();
+                record.add_directory(final_dir.string());
+                // Keep the newest `keep`.
+                std::vector<std::pair<long, fs::path>> existing;
+                for (const auto &entry : fs::directory_iterator(directory, ec))
+                  {
+                    const long s = step_of(entry.path().filename().string());
+                    if (s >= 0 && entry.is_directory(ec))
+                      existing.emplace_back(s, entry.path());
+                  }
+                std::sort(existing.begin(), existing.end());
+                for (std::size_t i = 0; i + keep < existing.size(); ++i)
+                  {
+                    fs::remove_all(existing[i].second, ec);
+                    record.remove(existing[i].second.string());
+                  }
+              }
+            catch (const RuntimeError &e)
+              {
+                problem = e.what();
+              }
         }
       problem = dealii::Utilities::MPI::broadcast(comm, problem, 0);
       if (!problem.empty())

@@ -14,6 +14,7 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <sstream>
 #include <sys/file.h>
@@ -359,15 +360,19 @@ namespace hysteron
       for (const auto &f : files)
         m << "    " << json(f) << (++i < files.size() ? ",\n" : "\n");
       m << "  ]\n}\n";
-      // Atomic, and not itself a file of the run.
+      // Atomic, and not itself a file of the run (so not an Output::AtomicFile, which
+      // records its file here).
       const std::string path = directory + "/" + manifest_name;
       std::ofstream     out(path + ".tmp");
       out << m.str();
       out.close();
-      if (out)
-        std::rename((path + ".tmp").c_str(), path.c_str());
-      else
-        std::remove((path + ".tmp").c_str());
+      const int error = errno;
+      if (!out || std::rename((path + ".tmp").c_str(), path.c_str()) != 0)
+        {
+          const int reason = out ? errno : error;
+          std::remove((path + ".tmp").c_str());
+          throw RuntimeError("cannot write '" + path + "': " + (reason != 0 ? std::strerror(reason) : "an input/output error"));
+        }
     }
 
     void
@@ -377,7 +382,15 @@ namespace hysteron
         return;
       status  = final_status;
       message = final_message;
-      write_manifest();
+      std::string failure;
+      try
+        {
+          write_manifest();
+        }
+      catch (const RuntimeError &e)
+        {
+          failure = e.what();
+        }
       Output::RunRecord::get().end();
       if (lock_fd >= 0)
         {
@@ -386,6 +399,13 @@ namespace hysteron
           lock_fd = -1;
         }
       directory.clear();
+      // A run that finished fails on it; a run that failed already keeps its own error.
+      if (!failure.empty())
+        {
+          if (final_status == "finished")
+            throw RuntimeError(failure);
+          std::cerr << "hysteron: warning: " << failure << std::endl;
+        }
     }
 
     OutputDirectory::~OutputDirectory()

@@ -16,6 +16,16 @@ Every scene in prm/ (and any given with --scene) is mutated one way at a time:
                or has a 300-character name
   command line --resume with no checkpoint, the file twice
 
+Two more families (each with rules of its own, in their modules):
+
+  inconsistent inputs that parse but are physically wrong (tests/fuzz/consistency.py):
+               conflicting boundary conditions, nearly incompressible material on elements
+               that lock, runs far beyond the memory, damaged Gmsh meshes (of the scenes
+               given with --mesh-scene, by default the Gmsh scenes of tests/fem)
+  faults       faults during a run (tests/fuzz/faults.py): a damaged, truncated or stale
+               checkpoint, an input edited before --resume, a full disk under each kind of
+               output file, a killed MPI rank
+
 The list of all mutations is built in a fixed order and shuffled with --seed, so a seed and
 a count name the same runs on every machine. Each mutation runs in its own directory with
 --quiet and a time limit; runs longer than a step budget are stopped through the
@@ -30,7 +40,7 @@ Each run must satisfy:
   - exit 0, 2 and 4 leave no *.tmp, and the tables of exit 0 and 4 hold no NaN or inf
     (a non-finite number in an accepted run's output is a silent wrong answer)
 
-  fuzz.py --hysteron build/hysteron --count 40 --seed 1              quick subset (ctest)
+  fuzz.py --hysteron build/hysteron --count 40 --inconsistent 8 --faults 4   quick subset (ctest)
   fuzz.py --hysteron build/hysteron --count 1200 --jobs 2 --report doc/reliability.md
 
 Exit status 0 when every run satisfies the rules; the failures are printed otherwise.
@@ -46,6 +56,10 @@ import signal
 import subprocess
 import sys
 import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import consistency  # noqa: E402
+import faults  # noqa: E402
 
 NUMBERS = ["0", "-1", "-0.0", "nan", "NaN", "inf", "-inf", "1e300", "-1e300", "1e-300",
            "-1e-300", "2147483647", "4294967297", "1e19", "abc", "", "0x1p3", "1e", "--1",
@@ -114,10 +128,22 @@ def value_mutations(key, value):
     return STRINGS
 
 
-def all_mutations(scenes):
-    """Every mutation, in a fixed order: (scene index, kind, detail)."""
+def family(kind):
+    if kind == "fault":
+        return "faults"
+    return "inconsistent" if kind in ("conflict", "locking", "memory", "mesh") else "syntax"
+
+
+def all_mutations(scenes, n_mesh_scenes=0):
+    """Every mutation, in a fixed order: (scene index, kind, detail). The last
+    @p n_mesh_scenes scenes only get damaged meshes."""
     out = []
     for s, scene in enumerate(scenes):
+        if s >= len(scenes) - n_mesh_scenes:
+            out += consistency.mutations(s, scene, mesh_scene=True)
+            continue
+        out += consistency.mutations(s, scene)
+        out += faults.mutations(s, scene)
         for i, (line, section, key, value) in enumerate(scene.entries):
             for new in value_mutations(key, value):
                 out.append((s, "value", [i, new]))
@@ -211,6 +237,8 @@ def build(scene, kind, detail, workdir):
         args = ["--quiet", "--resume", prm]
     elif kind == "file twice":
         args = ["--quiet", prm, prm]
+    elif family(kind) == "inconsistent":
+        label = consistency.build(scene, kind, detail, lines, workdir)
     text = "\n".join(lines)
     data = text.encode("utf-8")
     if kind == "crlf":
@@ -258,17 +286,11 @@ def non_finite_tables(directory, before):
     return bad
 
 
-def run_one(hysteron, scenes, index, mutation, root, limit, steps):
-    s, kind, detail = mutation
-    scene = scenes[s]
-    workdir = os.path.join(root, f"{index:05d}")
-    shutil.rmtree(workdir, ignore_errors=True)
-    os.makedirs(workdir)
-    args, label = build(scene, kind, detail, workdir)
-    before = listing(workdir)
-    env = dict(os.environ, HYSTERON_TEST_SIGNAL=f"SIGTERM@{steps}")
+def launch(command, cwd, env, limit):
+    """Run @p command in its own session; (status or None after @p limit s, stdout, stderr,
+    seconds)."""
     start = time.monotonic()
-    proc = subprocess.Popen([hysteron] + args, cwd=workdir, env=env, stdin=subprocess.DEVNULL,
+    proc = subprocess.Popen(command, cwd=cwd, env=env, stdin=subprocess.DEVNULL,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
     try:
         out, err = proc.communicate(timeout=limit)
@@ -277,12 +299,87 @@ def run_one(hysteron, scenes, index, mutation, root, limit, steps):
         os.killpg(proc.pid, signal.SIGKILL)
         out, err = proc.communicate()
         status = None
-    seconds = time.monotonic() - start
-    err = err.decode("utf-8", "replace")
+    return (status, out.decode("utf-8", "replace"), err.decode("utf-8", "replace"),
+            time.monotonic() - start)
+
+
+def run_fault(hysteron, scene, index, detail, workdir, limit, mpiexec):
+    """One fault of tests/fuzz/faults.py: several runs in @p workdir."""
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1")
+    env.pop("HYSTERON_TEST_SIGNAL", None)
+    total = [0.0]
+
+    def write_scene(lines, directory=workdir):
+        with open(os.path.join(directory, "scene.prm"), "w") as f:
+            f.write("\n".join(lines))
+
+    def execute(args, signal_spec, cwd=workdir, ranks=1, kill_rank=None, stdout=False):
+        run_env = dict(env)
+        if signal_spec:
+            run_env["HYSTERON_TEST_SIGNAL"] = signal_spec
+        command = [hysteron] + args
+        if ranks > 1:
+            rank, step = kill_rank
+            script = (f'if [ "$OMPI_COMM_WORLD_RANK" = {rank} ]; then '
+                      f'export HYSTERON_TEST_SIGNAL=SIGKILL@{step}; fi; exec "$@"')
+            command = [mpiexec, "-np", str(ranks), "sh", "-c", script, "sh"] + command
+        status, out, err, seconds = launch(command, cwd, run_env, limit)
+        total[0] += seconds
+        return status, (out if stdout else err), seconds
+
+    label, kind, problems, status, err = faults.run(hysteron, scene, detail, workdir,
+                                                    write_scene, execute, mpiexec)
+    if any(n.endswith(".tmp") for n in listing(workdir)):
+        problems.append("a *.tmp is left")
+    bad = non_finite_tables(workdir, set())
+    if bad:
+        problems.append("non-finite values in a table: " + ", ".join(bad[:3]))
+    if status is not None and status < 0 and kind != "not applicable":
+        problems.append(f"killed by signal {-status}")
+    if status == 3:
+        problems.append("exit status 3 (an internal error)")
     message = next((l for l in err.splitlines() if "error:" in l), err.strip()[-300:])
-    result = {"index": index, "scene": scene.name, "mutation": label, "status": status,
-              "seconds": round(seconds, 2), "message": message[:400], "problems": []}
+    return {"index": index, "scene": scene.name, "family": "faults", "mutation": label,
+            "status": status, "seconds": round(total[0], 2), "message": message[:400],
+            "class": "not applicable" if kind == "not applicable" else
+            "hang" if kind == "hang" else "fault", "problems": problems}
+
+
+def run_one(hysteron, scenes, index, mutation, root, limit, steps, mpiexec=None):
+    s, kind, detail = mutation
+    scene = scenes[s]
+    workdir = os.path.join(root, f"{index:05d}")
+    shutil.rmtree(workdir, ignore_errors=True)
+    os.makedirs(workdir)
+    if kind == "fault":
+        result = run_fault(hysteron, scene, index, detail, workdir, limit, mpiexec)
+        if not result["problems"]:
+            shutil.rmtree(workdir, ignore_errors=True)
+        return result
+    args, label = build(scene, kind, detail, workdir)
+    before = listing(workdir)
+    env = dict(os.environ, HYSTERON_TEST_SIGNAL=f"SIGTERM@{steps}")
+    status, _, err, seconds = launch([hysteron] + args, workdir, env, limit)
+    message = next((l for l in err.splitlines() if "error:" in l), err.strip()[-300:])
+    result = {"index": index, "scene": scene.name, "family": family(kind), "mutation": label,
+              "status": status, "seconds": round(seconds, 2), "message": message[:400],
+              "problems": []}
     problems = result["problems"]
+    if family(kind) == "inconsistent":
+        problems += consistency.expectation(scene, kind, detail, status, err, seconds)
+    if kind == "mesh" and status in (0, 4) and not problems:
+        # A repaired mesh must give the undamaged mesh's results.
+        reference = os.path.join(workdir, "reference")
+        os.makedirs(reference)
+        build(scene, "as is", [], reference)
+        status_ref, _, _, _ = launch([hysteron] + args, reference, env, limit)
+        output = consistency.output_directory(scene)
+        if status_ref == status:
+            problems += ["the repaired mesh's results differ: " + d for d in
+                         consistency.same_tables(os.path.join(workdir, output),
+                                                 os.path.join(reference, output))][:1]
+        shutil.rmtree(reference, ignore_errors=True)
     after = listing(workdir)
     if status is None:
         result["class"] = "hang"
@@ -318,21 +415,35 @@ def run_one(hysteron, scenes, index, mutation, root, limit, steps):
     return result
 
 
+FAMILIES = [("syntax", "syntax, values, files, command line"),
+            ("inconsistent", "physically inconsistent inputs"),
+            ("faults", "faults during a run")]
+
+
 def report(results, args, seconds, path):
-    classes = ["refused", "accepted", "run failed", "stopped at step budget", "crash", "hang"]
-    count = {c: sum(r["class"] == c for r in results) for c in classes}
-    failed = [r for r in results if r["problems"]]
+    classes = ["refused", "accepted", "run failed", "stopped at step budget", "fault",
+               "not applicable", "crash", "hang"]
     lines = [
-        f"| tried | refused cleanly (exit 1) | accepted (exit 0) | run failed cleanly (exit 2) "
-        f"| stopped at the step budget (exit 4) | crashes | hangs | rule violations |",
-        "|---|---|---|---|---|---|---|---|",
-        f"| {len(results)} | {count['refused'] - sum(r['class'] == 'refused' for r in failed)} "
-        f"| {count['accepted']} | {count['run failed']} | {count['stopped at step budget']} "
-        f"| {count['crash']} | {count['hang']} | {len(failed)} |",
+        "| family | tried | refused cleanly (exit 1) | accepted (exit 0) | run failed cleanly "
+        "(exit 2) | stopped at the step budget (exit 4) | faults handled | not applicable | "
+        "crashes | hangs | rule violations |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
+    for name, title in FAMILIES:
+        rs = [r for r in results if r["family"] == name]
+        if not rs:
+            continue
+        count = {c: sum(r["class"] == c for r in rs) for c in classes}
+        bad = [r for r in rs if r["problems"]]
+        clean = lambda c: count[c] - sum(r["class"] == c for r in bad)
+        lines.append(f"| {title} | {len(rs)} | {clean('refused')} | {clean('accepted')} | "
+                     f"{clean('run failed')} | {clean('stopped at step budget')} | "
+                     f"{clean('fault')} | {count['not applicable']} | {count['crash']} | "
+                     f"{count['hang']} | {len(bad)} |")
+    failed = [r for r in results if r["problems"]]
     table = "\n".join(lines)
     print(table)
-    print(f"\n{len(results)} mutations, seed {args.seed}, {seconds:.0f} s")
+    print(f"\n{len(results)} runs, seed {args.seed}, {seconds:.0f} s")
     for r in failed:
         print(f"FAIL {r['index']:5d} {r['scene']}: {r['mutation']}: status {r['status']}, "
               f"{r['seconds']} s: {'; '.join(r['problems'])}\n      {r['message']}")
@@ -340,10 +451,11 @@ def report(results, args, seconds, path):
         begin, end = "<!-- fuzz table begin -->", "<!-- fuzz table end -->"
         with open(path) as f:
             text = f.read()
-        body = (f"{begin}\n{table}\n\n`tests/fuzz/fuzz.py --count {args.count} --seed {args.seed}"
-                f" --steps {args.steps} --limit {args.limit}`: {len(results)} mutations of "
-                f"{len(set(r['scene'] for r in results))} scenes in {seconds / 60:.0f} min "
-                f"({args.jobs} at a time).\n{end}")
+        scenes = len(set(r["scene"] for r in results))
+        body = (f"{begin}\n{table}\n\n`tests/fuzz/fuzz.py --count {args.count} --inconsistent "
+                f"{args.inconsistent} --faults {args.faults} --seed {args.seed} --steps "
+                f"{args.steps} --limit {args.limit}`: {len(results)} cases of {scenes} scenes in "
+                f"{seconds / 60:.0f} min ({args.jobs} at a time).\n{end}")
         text = re.sub(re.escape(begin) + ".*?" + re.escape(end), lambda m: body, text, flags=re.S)
         with open(path + ".tmp", "w") as f:
             f.write(text)
@@ -357,7 +469,14 @@ def main():
     parser.add_argument("--hysteron", required=True)
     parser.add_argument("--scene", action="append", default=[],
                         help="scenes to mutate (default: every prm/*.prm)")
-    parser.add_argument("--count", type=int, default=40)
+    parser.add_argument("--mesh-scene", action="append", default=[],
+                        help="scenes with a Gmsh mesh to damage (default: tests/fem's)")
+    parser.add_argument("--count", type=int, default=40, help="syntax mutations to run")
+    parser.add_argument("--inconsistent", default="all",
+                        help="inconsistent inputs to run: a number or 'all'")
+    parser.add_argument("--faults", default="all", help="faults to run: a number or 'all'")
+    parser.add_argument("--mpiexec", default=shutil.which("mpirun"),
+                        help="MPI launcher for the killed-rank faults")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--jobs", type=int, default=1)
     parser.add_argument("--limit", type=float, default=60, help="seconds per run")
@@ -371,21 +490,32 @@ def main():
     paths = args.scene or sorted(
         os.path.join(here, "..", "..", "prm", n) for n in os.listdir(os.path.join(here, "..", "..", "prm"))
         if n.endswith(".prm"))
-    scenes = [Scene(os.path.abspath(p)) for p in paths]
-    mutations = all_mutations(scenes)
-    order = list(range(len(mutations)))
-    random.Random(args.seed).shuffle(order)
-    chosen = args.only if args.only is not None else order[:args.count]
+    tests = os.path.join(here, "..")
+    mesh_paths = args.mesh_scene or [os.path.join(tests, "fem", n) for n in
+                                     ("gmsh_mesh.prm", "simplex_gmsh_triangles.prm",
+                                      "physical_groups_tension.prm")]
+    scenes = [Scene(os.path.abspath(p)) for p in paths + mesh_paths]
+    mutations = all_mutations(scenes, len(mesh_paths))
+    chosen = []
+    for name, count in (("syntax", args.count), ("inconsistent", args.inconsistent),
+                        ("faults", args.faults)):
+        order = [i for i, m in enumerate(mutations) if family(m[1]) == name]
+        random.Random(args.seed).shuffle(order)
+        chosen += order if count == "all" else order[:int(count)]
+    if args.only is not None:
+        chosen = args.only
     hysteron = os.path.abspath(args.hysteron)
     root = os.path.abspath(args.workdir)
     os.makedirs(root, exist_ok=True)
-    print(f"{len(mutations)} mutations of {len(scenes)} scenes; running {len(chosen)}", flush=True)
+    print(f"{len(mutations)} cases of {len(scenes)} scenes ("
+          + ", ".join(f"{sum(family(m[1]) == n for m in mutations)} {n}" for n, _ in FAMILIES)
+          + f"); running {len(chosen)}", flush=True)
 
     start = time.monotonic()
     results = []
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         futures = [pool.submit(run_one, hysteron, scenes, i, mutations[i], root, args.limit,
-                               args.steps) for i in chosen]
+                               args.steps, args.mpiexec) for i in chosen]
         for done, future in enumerate(concurrent.futures.as_completed(futures), 1):
             r = future.result()
             results.append(r)
