@@ -374,7 +374,8 @@ namespace hysteron
     {
       const auto &bodies = scene.body_descriptions();
       springs.assign(network.facets.size(), Springs<dim>());
-      for (unsigned int e = 0; e < network.facets.size(); ++e)
+      std::string out_of_range, where; // the first facet whose springs overflow
+      for (unsigned int e = 0; e < network.facets.size() && out_of_range.empty(); ++e)
         {
           const Facet<dim> &f  = network.facets[e];
           Springs<dim>     &sp = springs[e];
@@ -458,6 +459,24 @@ namespace hysteron
                   }
             }
           facet.k = sp.k;
+          // Finite inputs can still overflow here (a thickness of 1e300): the stiffnesses
+          // and the forces they lead to (E A bounds the yield forces) must be numbers.
+          if (out_of_range.empty())
+            for (unsigned int i = 0; i < n_dofs; ++i)
+              if (!(sp.k[i] > 0 && std::isfinite(sp.k[i]) &&
+                    std::isfinite(sp.area * std::max(ma.elasticity().youngs_modulus, mb.elasticity().youngs_modulus))))
+                {
+                  std::ostringstream m;
+                  m << "the facet between the cells at " << local_nuclei[f.a] << " and " << local_nuclei[f.b]
+                    << " gets a spring stiffness of " << sp.k[i] << " (area " << sp.area << ", Young's modulus "
+                    << ma.elasticity().youngs_modulus << "): the geometry and the material are out of the range "
+                    << "of double precision together";
+                  out_of_range = m.str();
+                  where        = dim == 2 ? "Body " + ba.name + "/Thickness" : "Material/Young's modulus";
+                  break;
+                }
+          if (!out_of_range.empty())
+            continue;
 
           // The spring law's springs (static: linear springs, the plasticity ignored).
           if (analysis != Analysis::linear_static)
@@ -471,6 +490,11 @@ namespace hysteron
             sp.tangent[i][i] = sp.k[i]; // the first predictor's
           sp.trial_state = sp.state;
         }
+      // Every rank refuses, with the first rank's facet.
+      const auto found = dealii::Utilities::MPI::all_gather(scene.mpi_communicator(), std::make_pair(where, out_of_range));
+      for (const auto &[place, problem] : found)
+        if (!problem.empty())
+          throw InputError(place, problem);
     }
 
 
