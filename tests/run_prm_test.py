@@ -35,7 +35,9 @@ The scene runs in a fresh working directory (relative output paths land there) w
                                   at round-off level)
 
 Expressions are Python over the CSV column names, with abs, sqrt, exp, log, tanh, sin, cos,
-pi, min, max, sum, len, all, any, and `i` (the row index) for CHECK.
+pi, min, max, sum, len, all, any, `i` (the row index) for CHECK, and table(<file>): the
+columns of another CSV file of the run (a dict of lists), to relate two tables (e.g. the
+facet forces of springs.csv to the reactions of reactions.csv).
 Exit status 0 when every assertion holds; the failures are printed otherwise.
 """
 import argparse
@@ -214,6 +216,10 @@ def main():
 
     # CHECKs hold on a successful run, and on the last good state a failed run (EXIT: 2) wrote.
     if not expect_error or expected_code == 2:
+        def table(name):
+            columns, values = read_csv(os.path.join(args.workdir, name))
+            return {h: [r[j] for r in values] for j, h in enumerate(columns)}
+
         for kind, target, expr in directives:
             if kind not in ("CHECK", "CHECK-LAST", "CHECK-COLUMNS"):
                 continue
@@ -228,7 +234,7 @@ def main():
                 continue
             try:
                 if kind == "CHECK-COLUMNS":
-                    scope = dict(SAFE)
+                    scope = dict(SAFE, table=table)
                     scope.update({h: [r[j] for r in rows] for j, h in enumerate(header)})
                     if not eval(expr, dict(scope, __builtins__={})):
                         failures.append(f"{kind} {target}: {expr} is false")
@@ -236,7 +242,7 @@ def main():
                     selected = [(len(rows) - 1, rows[-1])] if kind == "CHECK-LAST" else \
                         list(enumerate(rows))
                     for i, r in selected:
-                        scope = dict(SAFE)
+                        scope = dict(SAFE, table=table)
                         scope.update(dict(zip(header, r)))
                         scope["i"] = i
                         if not eval(expr, dict(scope, __builtins__={})):
