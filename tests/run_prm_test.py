@@ -7,6 +7,9 @@ The scene runs in a fresh working directory (relative output paths land there) w
   # CHECK <file>: <expr>          holds on every data row of the CSV <file>
   # CHECK-LAST <file>: <expr>     holds on the last row
   # CHECK-COLUMNS <file>: <expr>  holds once, each column bound to the list of its values
+  # CHECK-SCRIPT: <script> [args]  a Python script (path relative to the .prm) run in the
+                                  working directory after the scene must exit with 0: for
+                                  checks that would not fit one expression
   # EXPECT-ERROR: <regex>         the run must fail (exit status 1, or the one of EXIT),
                                   stderr must match <regex>, and no output file may be
                                   left behind (exit 1: nothing at all, not even parameters.prm
@@ -61,7 +64,7 @@ SAFE = {
 
 def parse_directives(path):
     directives = []
-    pattern = re.compile(r"^\s*#\s*(CHECK-LAST|CHECK-COLUMNS|CHECK|EXPECT-ERROR|EXPECT-STDERR|EXPECT-STDOUT|EXIT|"
+    pattern = re.compile(r"^\s*#\s*(CHECK-LAST|CHECK-COLUMNS|CHECK-SCRIPT|CHECK|EXPECT-ERROR|EXPECT-STDERR|EXPECT-STDOUT|EXIT|"
                          r"ARGS|FILES|RANKS|MAX-SECONDS|MPI-TOLERANCE|MPI-IGNORE|MPI)\b\s*([^:]*):\s?(.*)$")
     with open(path) as f:
         for line in f:
@@ -221,6 +224,13 @@ def main():
             return {h: [r[j] for r in values] for j, h in enumerate(columns)}
 
         for kind, target, expr in directives:
+            if kind == "CHECK-SCRIPT":
+                words = expr.split()
+                script = os.path.join(os.path.dirname(os.path.abspath(prm)), words[0])
+                code, out_s, err_s = run([sys.executable, script] + words[1:], args.workdir, env)
+                if code != 0:
+                    failures.append(f"CHECK-SCRIPT {expr}: exit {code}\n{out_s}{err_s}")
+                continue
             if kind not in ("CHECK", "CHECK-LAST", "CHECK-COLUMNS"):
                 continue
             path = os.path.join(args.workdir, target)
@@ -293,7 +303,7 @@ def main():
                     failures.append(f"{ranks} ranks: {f} differs from the 1-rank run")
 
     n_checks = sum(1 for k, _, _ in directives
-                   if k in ("CHECK", "CHECK-LAST", "CHECK-COLUMNS", "EXPECT-ERROR", "MPI", "MAX-SECONDS",
+                   if k in ("CHECK", "CHECK-LAST", "CHECK-COLUMNS", "CHECK-SCRIPT", "EXPECT-ERROR", "MPI", "MAX-SECONDS",
                             "EXPECT-STDERR", "EXPECT-STDOUT"))
     if n_checks == 0 and not expect_error:
         failures.append("the test has no assertion (add a CHECK, EXPECT-ERROR or MPI line)")
