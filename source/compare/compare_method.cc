@@ -87,7 +87,19 @@ namespace hysteron
           {
             scene.console() << "compare: running '" << names[m] << "' into "
                             << this->output_file(names[m]) << "/" << std::endl;
-            methods[m]->run();
+            try
+              {
+                methods[m]->run();
+              }
+            catch (const Interrupted &e)
+              {
+                // The method's own message offers --resume, which a comparison cannot do
+                // (checkpoint_unsupported()): its tables up to here stay, the run starts anew.
+                const std::string text = e.what();
+                throw Interrupted(text.substr(0, text.find("; the state was written")) + " ('" + names[m] +
+                                  "' of a comparison); its tables up to here are written. A comparison "
+                                  "cannot be resumed: run the scene again");
+              }
             summaries[m] = methods[m]->summary();
           }
 

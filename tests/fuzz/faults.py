@@ -205,6 +205,8 @@ def run(hysteron, scene, detail, workdir, write_scene, execute, mpiexec):
         write_scene(lines, workdir)
     tables = _tables(output)
     status, err, _ = execute(["--quiet", "--resume", "scene.prm"], "SIGTERM@6")
+    if status == 1 and "does not write checkpoints" in err:
+        return label, "not applicable", [], status, err  # a comparison starts anew
     if status in (0, 4):
         if kind != "stale" and not any(w in err for w in ("skipping", "resuming from",
                                                           "newer checkpoint")):
