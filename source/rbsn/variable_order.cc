@@ -1,8 +1,7 @@
-#include <deal.II/base/index_set.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
-#include <deal.II/sundials/ida.h>
 
 #include <hysteron/base/parameters.h>
+#include "base/ida_integrator.h"
 #include "base/sparse_lu.h"
 #include <hysteron/rbsn/model.h>
 #include <hysteron/run/stepping_method.h>
@@ -15,9 +14,9 @@
 /*
  * Analysis = variable order: the state-space form of eq. 3.43-3.48 as an
  * implicit DAE F(t, y, y') = 0 in y = (u, v, s, W), integrated by SUNDIALS IDA
- * (variable-order, variable-step BDF with local error control) through deal.II's
- * wrapper. With n = 3 (2D) or 6 (3D) DoFs per cell, s the Bouc-Wen states of the hysteretic springs
- * (z, and eta, e_h with degradation), and W three work quadratures:
+ * (variable-order, variable-step BDF with local error control; base/ida_integrator.h).
+ * With n = 3 (2D) or 6 (3D) DoFs per cell, s the Bouc-Wen states of the hysteretic
+ * springs (z, and eta, e_h with degradation), and W three work quadratures:
  *
  *   free DoF i:        u_i' - v_i = 0,
  *                      (M v' + C v + f_int(u, s) - f_ext(t))_i = 0,
@@ -34,39 +33,21 @@
  * parse time: a break is a discontinuity of the right-hand side.
  */
 
-namespace
-{
-  // deal.II 9.4's IDA keeps its SUNDIALS memory private, so it offers neither the
-  // integrator's statistics nor a maximum step. An explicit instantiation may name a
-  // private member (C++17 [temp.spec]/6), which gives the pointer to it.
-  using Ida = dealii::SUNDIALS::IDA<dealii::Vector<double>>;
-
-  struct IdaMemory
-  {
-    using type = void *Ida::*;
-    friend type
-    member(IdaMemory);
-  };
-
-  template <typename Tag, typename Tag::type pointer>
-  struct Expose
-  {
-    friend typename Tag::type
-    member(Tag)
-    {
-      return pointer;
-    }
-  };
-
-  template struct Expose<IdaMemory, &Ida::ida_mem>;
-} // namespace
-
-
-
 namespace hysteron
 {
   namespace RBSN
   {
+    namespace
+    {
+      bool
+      all_finite(const dealii::ArrayView<const double> values)
+      {
+        return std::all_of(values.begin(), values.end(), [](const double x) { return std::isfinite(x); });
+      }
+    } // namespace
+
+
+
     template <int dim>
     void
     Model<dim>::declare_variable_order_parameters(dealii::ParameterHandler &prm)
@@ -131,20 +112,23 @@ namespace hysteron
     class Model<dim>::VariableOrder
     {
     public:
-      using Vector = dealii::Vector<double>; ///< IDA's vectors (the whole network on every rank)
+      // IDA's vectors: the whole network on every rank.
+      using Vector    = dealii::Vector<double>;
+      using ConstView = IdaIntegrator::ConstView;
+      using View      = IdaIntegrator::View;
       static constexpr unsigned int n_dofs = Model<dim>::n_dofs;
 
       explicit VariableOrder(Model<dim> &model);
 
       /// F(t, y, y'); returns 0, or 1 (recoverable: IDA retries with a smaller step).
       int
-      residual(const double t, const Vector &y, const Vector &yp, Vector &F);
+      residual(const double t, const ConstView y, const ConstView yp, const View F);
       /// Assemble dF/dy + cj dF/dy' at y (it does not depend on t and y') and factorise it.
       int
-      setup_jacobian(const Vector &y, const double cj);
+      setup_jacobian(const ConstView y, const double cj);
       /// x = J^-1 rhs with the factorisation of the last setup_jacobian().
       int
-      solve(const Vector &rhs, Vector &x);
+      solve(const ConstView rhs, const View x);
 
       /// The initial y and a consistent y' from the model's initial state.
       void
@@ -153,14 +137,11 @@ namespace hysteron
       void
       to_model(const double t, const Vector &y, const Vector &yp);
 
-      dealii::IndexSet
+      /// Per component: 1 differential, 0 algebraic (the prescribed DoFs' velocities).
+      std::vector<double>
       differential_components() const;
 
-      Vector       tolerances;
-      unsigned int size() const
-      {
-        return n_total;
-      }
+      std::vector<double> tolerances; ///< IDA's absolute tolerances
 
     private:
       Model<dim>  &m;
@@ -172,6 +153,7 @@ namespace hysteron
       std::vector<typename SpringLaw<dim>::UniaxialSpring> uniaxial;
       std::vector<double>           w; ///< prescribed velocities at the last t
       Vector                        reaction;
+      Vector                        lu_rhs, lu_x; ///< the direct solver's vectors
       typename Model<dim>::Vector   f_ext; ///< the model's layout (one part: all DoFs)
       dealii::SparsityPattern       pattern;
       dealii::SparseMatrix<double>  jacobian;
@@ -227,6 +209,8 @@ namespace hysteron
       n_total = 2 * n + n_states + 3;
       w.assign(n, 0.0);
       reaction.reinit(n);
+      lu_rhs.reinit(n_total);
+      lu_x.reinit(n_total);
       f_ext.reinit(m.partitioner);
 
       // The Newton matrix's pattern: kinematic rows (u_i, u_i), (u_i, v_i); the cells'
@@ -278,11 +262,11 @@ namespace hysteron
       const double t_out = m.time_step > 0 ? m.time_step :
                            m.scene.time_control().time_step > 0 ? m.scene.time_control().time_step :
                                                                   m.scene.time_control().end_time / m.n_increments;
-      tolerances.reinit(n_total);
+      tolerances.assign(n_total, 0.0);
       for (unsigned int i = 0; i < n; ++i)
         {
-          tolerances(i)     = i % n_dofs >= dim ? atol / m.scale : atol;
-          tolerances(n + i) = tolerances(i) / t_out;
+          tolerances[i]     = i % n_dofs >= dim ? atol / m.scale : atol;
+          tolerances[n + i] = tolerances[i] / t_out;
         }
       for (unsigned int e = 0; e < m.springs.size(); ++e)
         if (state_offset[n_dofs * e] >= 0)
@@ -290,11 +274,11 @@ namespace hysteron
             {
               const auto        &spring = law(e, i);
               const unsigned int s0     = s_index(e, i);
-              tolerances(s0)            = i >= dim ? atol / m.scale : atol;
+              tolerances[s0]            = i >= dim ? atol / m.scale : atol;
               if (spring.degradation())
                 {
-                  tolerances(s0 + Material::BoucWenUniaxial::eta_index)    = p.relative_tolerance;
-                  tolerances(s0 + Material::BoucWenUniaxial::energy_index) = tolerances(s0) * spring.yield_value();
+                  tolerances[s0 + Material::BoucWenUniaxial::eta_index]    = p.relative_tolerance;
+                  tolerances[s0 + Material::BoucWenUniaxial::energy_index] = tolerances[s0] * spring.yield_value();
                 }
             }
       // The works: 1e-2 k_max d atol, the work of the largest normal spring's force at
@@ -304,24 +288,21 @@ namespace hysteron
       for (const auto &sp : m.springs)
         k_max = std::max(k_max, sp.k[0]);
       for (unsigned int j = 2 * n + n_states; j < n_total; ++j)
-        tolerances(j) = 1e-2 * k_max * atol * atol / p.relative_tolerance;
+        tolerances[j] = 1e-2 * k_max * atol * atol / p.relative_tolerance;
     }
 
 
 
     template <int dim>
-    dealii::IndexSet
+    std::vector<double>
     Model<dim>::VariableOrder::differential_components() const
     {
       // All but the velocities of the prescribed DoFs.
-      dealii::IndexSet set(n_total);
-      set.add_range(0, n_total);
-      dealii::IndexSet algebraic(n_total);
+      std::vector<double> differential(n_total, 1.0);
       for (unsigned int i = 0; i < n; ++i)
         if (m.dof_set[i] >= 0)
-          algebraic.add_index(n + i);
-      set.subtract_set(algebraic);
-      return set;
+          differential[n + i] = 0.0;
+      return differential;
     }
 
 
@@ -338,20 +319,20 @@ namespace hysteron
 
     template <int dim>
     int
-    Model<dim>::VariableOrder::residual(const double t, const Vector &y, const Vector &yp, Vector &F)
+    Model<dim>::VariableOrder::residual(const double t, const ConstView y, const ConstView yp, const View F)
     {
       prescribed_velocities(t);
       m.external_forces(t, f_ext);
       const double a0 = m.dynamics.rayleigh_mass, a1 = m.dynamics.rayleigh_stiffness;
-      F = 0;
+      std::fill(F.begin(), F.end(), 0.0);
       // Kinematics.
       for (unsigned int i = 0; i < n; ++i)
         if (m.dof_set[i] < 0)
-          F(i) = yp(i) - y(n + i);
+          F[i] = yp[i] - y[n + i];
         else
           {
-            F(i)     = yp(i) - w[i];
-            F(n + i) = y(n + i) - w[i];
+            F[i]     = yp[i] - w[i];
+            F[n + i] = y[n + i] - w[i];
           }
 
       // reaction = M (v' + a0 v) + f_int + a1 K0 v - f_ext on every DoF.
@@ -364,7 +345,7 @@ namespace hysteron
           m.cell_mass_matrix(c, M);
           for (unsigned int p = 0; p < n_dofs; ++p)
             for (unsigned int q = 0; q < n_dofs; ++q)
-              reaction(n_dofs * c + p) += M(p, q) * (yp(n + n_dofs * c + q) + a0 * y(n + n_dofs * c + q));
+              reaction(n_dofs * c + p) += M(p, q) * (yp[n + n_dofs * c + q] + a0 * y[n + n_dofs * c + q]);
         }
       double power_int = 0, power_ext = 0, power_bnd = 0;
       std::array<double, 2 * n_dofs> U, V;
@@ -374,8 +355,8 @@ namespace hysteron
           const auto          dofs = facet_dofs(e);
           for (unsigned int k = 0; k < 2 * n_dofs; ++k)
             {
-              U[k] = y(dofs[k]);
-              V[k] = y(n + dofs[k]);
+              U[k] = y[dofs[k]];
+              V[k] = y[n + dofs[k]];
             }
           for (unsigned int i = 0; i < n_dofs; ++i)
             {
@@ -388,11 +369,11 @@ namespace hysteron
                   const unsigned int s0 = s_index(e, i), k = spring.n_state_variables();
                   double             state[Material::BoucWenUniaxial::max_n_state_variables], R[3];
                   for (unsigned int j = 0; j < k; ++j)
-                    state[j] = y(s0 + j);
+                    state[j] = y[s0 + j];
                   force = spring.stress(delta, state);
                   spring.state_rate(state, rate, R);
                   for (unsigned int j = 0; j < k; ++j)
-                    F(s0 + j) = yp(s0 + j) - R[j];
+                    F[s0 + j] = yp[s0 + j] - R[j];
                 }
               power_int += force * rate;
               const double total = force + a1 * sp.k[i] * rate;
@@ -402,24 +383,24 @@ namespace hysteron
         }
       for (unsigned int i = 0; i < n; ++i)
         {
-          power_ext += f_ext.local_element(i) * y(n + i);
+          power_ext += f_ext.local_element(i) * y[n + i];
           if (m.dof_set[i] < 0)
-            F(n + i) = reaction(i);
+            F[n + i] = reaction(i);
           else
             power_bnd += reaction(i) * w[i];
         }
       const unsigned int iw = 2 * n + n_states;
-      F(iw)     = yp(iw) - power_int;
-      F(iw + 1) = yp(iw + 1) - power_ext;
-      F(iw + 2) = yp(iw + 2) - power_bnd;
-      return std::isfinite(F.l2_norm()) ? 0 : 1;
+      F[iw]     = yp[iw] - power_int;
+      F[iw + 1] = yp[iw + 1] - power_ext;
+      F[iw + 2] = yp[iw + 2] - power_bnd;
+      return all_finite(F) ? 0 : 1;
     }
 
 
 
     template <int dim>
     int
-    Model<dim>::VariableOrder::setup_jacobian(const Vector &y, const double cj)
+    Model<dim>::VariableOrder::setup_jacobian(const ConstView y, const double cj)
     {
       const double a0 = m.dynamics.rayleigh_mass, a1 = m.dynamics.rayleigh_stiffness;
       jacobian = 0;
@@ -443,17 +424,13 @@ namespace hysteron
               for (unsigned int q = 0; q < n_dofs; ++q)
                 jacobian.add(n + n_dofs * c + p, n + n_dofs * c + q, (cj + a0) * M(p, q));
         }
-      std::array<double, 2 * n_dofs> U, V;
+      std::array<double, 2 * n_dofs> V; // the facet's velocities (the rates' derivatives)
       for (unsigned int e = 0; e < m.springs.size(); ++e)
         {
           const Springs<dim> &sp   = m.springs[e];
           const auto          dofs = facet_dofs(e);
           for (unsigned int k = 0; k < 2 * n_dofs; ++k)
-            {
-              U[k] = y(dofs[k]);
-              V[k] = y(n + dofs[k]);
-            }
-          (void)U;
+            V[k] = y[n + dofs[k]];
           for (unsigned int i = 0; i < n_dofs; ++i)
             {
               // dF/d delta = a k (the z part is a state of its own), dF/dz = (1 - a) k.
@@ -478,7 +455,7 @@ namespace hysteron
               // s' - R(s, B_i v): c_j I - dR/ds, and -dR/d delta' B_i in the v columns.
               double state[3], dR_ds[9], dR_dr[3];
               for (unsigned int j = 0; j < k; ++j)
-                state[j] = y(s0 + j);
+                state[j] = y[s0 + j];
               spring.state_rate_derivatives(state, sp.deformation(i, V), dR_ds, dR_dr);
               for (unsigned int r = 0; r < k; ++r)
                 {
@@ -507,17 +484,19 @@ namespace hysteron
 
     template <int dim>
     int
-    Model<dim>::VariableOrder::solve(const Vector &rhs, Vector &x)
+    Model<dim>::VariableOrder::solve(const ConstView rhs, const View x)
     {
+      std::copy(rhs.begin(), rhs.end(), lu_rhs.begin());
       try
         {
-          direct.solve(x, rhs);
+          direct.solve(lu_x, lu_rhs);
         }
       catch (const std::runtime_error &)
         {
           return 1; // recoverable: IDA retries with a smaller step
         }
-      return std::isfinite(x.l2_norm()) ? 0 : 1;
+      std::copy(lu_x.begin(), lu_x.end(), x.begin());
+      return all_finite(x) ? 0 : 1;
     }
 
 
@@ -547,7 +526,7 @@ namespace hysteron
       y(iw + 1) = m.external_work;
       y(iw + 2) = m.boundary_work;
       Vector F(n_total);
-      residual(0, y, yp, F);
+      residual(0, dealii::make_array_view(y), dealii::make_array_view(yp), dealii::make_array_view(F));
       for (unsigned int j = 0; j < n_total; ++j)
         yp(j) = j >= n && j < 2 * n ? (m.dof_set[j - n] < 0 ? m.a.local_element(j - n) : 0.0) : -F(j);
     }
@@ -558,8 +537,9 @@ namespace hysteron
     void
     Model<dim>::VariableOrder::to_model(const double t, const Vector &y, const Vector &yp)
     {
+      // The residual leaves reaction = f_int + M v' + C v - f_ext and f_ext at t.
       Vector F(n_total);
-      residual(t, y, yp, F); // reaction = f_int + M v' + C v - f_ext, f_ext at t
+      residual(t, dealii::make_array_view(y), dealii::make_array_view(yp), dealii::make_array_view(F));
       m.f_ext = f_ext;
       m.f_ext_old = f_ext; // the converged external force (history tables)
       std::array<double, 2 * n_dofs> U;
@@ -607,106 +587,71 @@ namespace hysteron
     template <int dim>
     double
     Model<dim>::integrate_variable_order(const double                       output_interval,
-                                    const std::function<void(double)> &step_finished)
+                                         const std::function<void(double)> &step_finished)
     {
       const auto  &p        = variable_order;
       const double end_time = scene.time_control().end_time;
       VariableOrder dae(*this);
-      using Vector = dealii::Vector<double>;
+      dealii::Vector<double> y, yp;
+      dae.initial_values(y, yp);
 
-      using Data = Ida::AdditionalData;
-      Data data(0,
-                end_time,
-                p.initial_step, // IDASetInitStep: 0 lets IDA estimate it
-                output_interval,
-                0, // minimum step: unused by the 9.4 wrapper
-                p.maximum_order,
-                10, // Newton iterations per step (IDA's default is 4)
-                0,  // the linear solver's tolerance factor: IDA's default (a direct solver)
-                0,  // absolute tolerance: replaced by the local tolerances
-                p.relative_tolerance,
-                true, // the prescribed velocities (algebraic) stay out of the error test
-                Data::none, // y(0), y'(0) are consistent (initial_values())
-                Data::none);
-      Ida ida(data);
-      ida.reinit_vector = [&](Vector &x) { x.reinit(dae.size()); };
-      ida.residual      = [&](const double t, const Vector &y, const Vector &yp, Vector &F) {
+      IdaIntegrator::Settings settings;
+      settings.relative_tolerance  = p.relative_tolerance;
+      settings.absolute_tolerances = dae.tolerances;
+      settings.differential        = dae.differential_components();
+      // The prescribed velocities (algebraic) stay out of the error test.
+      settings.suppress_algebraic_errors = true;
+      settings.initial_step              = p.initial_step;
+      settings.maximum_step              = p.maximum_step;
+      settings.stop_time                 = end_time;
+      settings.maximum_order             = p.maximum_order;
+      settings.maximum_newton_iterations = 10; // IDA's default is 4
+      settings.maximum_steps             = 1000000;
+      IdaIntegrator ida(settings, 0, dealii::make_array_view(y), dealii::make_array_view(yp));
+      ida.residual = [&](const double t, const auto y, const auto yp, const auto F) {
         return dae.residual(t, y, yp, F);
       };
-      ida.setup_jacobian = [&](const double, const Vector &y, const Vector &, const double cj) {
+      ida.setup_jacobian = [&](const double, const auto y, const auto, const double cj) {
         return dae.setup_jacobian(y, cj);
       };
-      ida.solve_with_jacobian = [&](const Vector &rhs, Vector &x, const double) { return dae.solve(rhs, x); };
-      ida.differential_components = [&]() { return dae.differential_components(); };
-      ida.get_local_tolerances    = [&]() -> Vector & { return dae.tolerances; };
+      ida.solve_jacobian = [&](const auto rhs, const auto x) { return dae.solve(rhs, x); };
 
-      const double eps      = 1e-12 * end_time;
-      double       last_good = 0;
-      std::string  ida_error;
-      ida.output_step       = [&](const double t, const Vector &y, const Vector &yp, const unsigned int k) {
-        void *mem = ida.*member(IdaMemory());
-        // The output step runs after IDA's (re)initialisation and before each IDASolve.
-        IDASetMaxNumSteps(mem, 1000000);
-        // IDA's messages: errors are kept for the failure report below; warnings are
-        // dropped (its linear-solver monitor counts one 'iteration' per direct solve and
-        // warns about convergence failure rates within short output intervals).
-        IDASetErrHandlerFn(
-          mem,
-          [](int code, const char *, const char *function, char *message, void *data) {
-            if (code < 0)
-              *static_cast<std::string *>(data) = std::string(function) + ": " + message;
-          },
-          &ida_error);
-        if (p.maximum_step > 0)
-          IDASetMaxStep(mem, p.maximum_step);
-        if (k == 0)
-          return; // t = 0 is written by run()
-        // IDASolve returns at the output time unless it failed (the wrapper does not
-        // check its status in a release build).
-        const double expected = std::min(k * output_interval, end_time);
-        long     steps = 0, residuals = 0, setups = 0, iterations = 0, error_fails = 0, convergence_fails = 0;
-        int      order = 0;
-        double   h     = 0;
-        IDAGetNumSteps(mem, &steps);
-        IDAGetLastOrder(mem, &order);
-        IDAGetLastStep(mem, &h);
-        IDAGetNumResEvals(mem, &residuals);
-        IDAGetNumLinSolvSetups(mem, &setups);
-        IDAGetNumNonlinSolvIters(mem, &iterations);
-        IDAGetNumErrTestFails(mem, &error_fails);
-        IDAGetNumNonlinSolvConvFails(mem, &convergence_fails);
-        n_steps  = steps;
-        n_newton = iterations;
-        if (std::abs(t - expected) > eps)
-          {
-            double t_reached = 0;
-            IDAGetCurrentTime(mem, &t_reached);
-            std::ostringstream s;
-            s << "rbsn: IDA did not reach t = " << expected << " s (it stopped at t = " << t_reached
-              << " s with the step " << h << " s after " << steps << " steps, " << error_fails
-              << " error test and " << convergence_fails << " convergence failures): a stiff or "
-              << "non-smooth response beyond the tolerances, an unsupported network, or too many "
-              << "steps (1e6 per output interval).";
-            if (!ida_error.empty())
-              s << " IDA: " << ida_error;
-            throw Run::StepFailure(s.str());
-          }
-        // The wrapper's output times accumulate round-off (t is k output_interval within
-        // eps): the tables get the nominal time, and a last interval of round-off length
-        // is not written again.
-        if (expected - last_good < eps)
-          return;
-        dae.to_model(expected, y, yp);
-        last_good = expected;
-        if (newton_table)
-          newton_table->add_row({expected, double(steps), double(order), h, double(residuals), double(setups),
-                                 double(iterations), double(error_fails), double(convergence_fails)});
-        step_finished(expected);
-      };
-
-      Vector y, yp;
-      dae.initial_values(y, yp);
-      ida.solve_dae(y, yp);
+      // The output times are sums of output intervals, which accumulate round-off: the
+      // tables get the nominal time k output_interval, and a last interval of round-off
+      // length is not written again. t = 0 is written by run().
+      const double eps = 1e-12 * end_time;
+      double       t = 0, t_out = 0, last_good = 0;
+      for (unsigned int k = 1; t < end_time; ++k)
+        {
+          t_out += output_interval;
+          const bool   reached  = ida.advance(t_out, t);
+          const double expected = std::min(k * output_interval, end_time);
+          const auto   stats    = ida.statistics();
+          n_steps               = stats.steps;
+          n_newton              = stats.newton_iterations;
+          if (!reached || std::abs(t - expected) > eps)
+            {
+              std::ostringstream s;
+              s << "rbsn: IDA did not reach t = " << expected << " s (it stopped at t = " << stats.time
+                << " s with the step " << stats.step << " s after " << stats.steps << " steps, "
+                << stats.error_test_failures << " error test and " << stats.convergence_failures
+                << " convergence failures): a stiff or non-smooth response beyond the tolerances, an "
+                << "unsupported network, or too many steps (1e6 per output interval).";
+              if (!ida.error().empty())
+                s << " IDA: " << ida.error();
+              throw Run::StepFailure(s.str());
+            }
+          if (expected - last_good < eps)
+            continue;
+          dae.to_model(expected, y, yp);
+          last_good = expected;
+          if (newton_table)
+            newton_table->add_row({expected, double(stats.steps), double(stats.order), stats.step,
+                                   double(stats.residuals), double(stats.jacobians),
+                                   double(stats.newton_iterations), double(stats.error_test_failures),
+                                   double(stats.convergence_failures)});
+          step_finished(expected);
+        }
       return end_time;
     }
 
