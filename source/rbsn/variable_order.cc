@@ -608,11 +608,11 @@ namespace hysteron
       settings.maximum_newton_iterations = 10; // IDA's default is 4
       settings.maximum_steps             = 1000000;
       IdaIntegrator ida(settings, 0, dealii::make_array_view(y), dealii::make_array_view(yp));
-      ida.residual = [&](const double t, const auto y, const auto yp, const auto F) {
-        return dae.residual(t, y, yp, F);
+      ida.residual = [&](const double t, const auto values, const auto rates, const auto F) {
+        return dae.residual(t, values, rates, F);
       };
-      ida.setup_jacobian = [&](const double, const auto y, const auto, const double cj) {
-        return dae.setup_jacobian(y, cj);
+      ida.setup_jacobian = [&](const double, const auto values, const auto, const double cj) {
+        return dae.setup_jacobian(values, cj);
       };
       ida.solve_jacobian = [&](const auto rhs, const auto x) { return dae.solve(rhs, x); };
 
