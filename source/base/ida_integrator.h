@@ -55,14 +55,17 @@ namespace hysteron
     {
       long   steps = 0, residuals = 0, jacobians = 0, newton_iterations = 0;
       long   error_test_failures = 0, convergence_failures = 0;
-      int    order = 0;     ///< of the last step
-      double step  = 0;     ///< the last step's size
-      double time  = 0;     ///< the time IDA has reached (its last step's end)
+      int    order = 0; ///< of the last step
+      double step  = 0; ///< the last step's size
+      double time  = 0; ///< the time IDA has reached (its last step's end)
     };
 
-    std::function<int(double t, ConstView y, ConstView yp, View F)>           residual;
-    std::function<int(double t, ConstView y, ConstView yp, double c_j)>       setup_jacobian;
-    std::function<int(ConstView rhs, View x)>                                 solve_jacobian;
+    /// F(t, y, y').
+    std::function<int(double t, ConstView y, ConstView yp, View F)> residual;
+    /// Assemble and factorise Newton's matrix dF/dy + c_j dF/dy' at (t, y, y').
+    std::function<int(double t, ConstView y, ConstView yp, double c_j)> setup_jacobian;
+    /// x = the last factorised matrix's inverse times rhs.
+    std::function<int(ConstView rhs, View x)> solve_jacobian;
 
     /// IDA at t0 with y(t0) and y'(t0), which must be consistent (IDA does not correct
     /// them). y and yp stay the caller's: advance() writes the solution into them.
