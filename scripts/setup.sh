@@ -17,6 +17,8 @@ packages=(
   libcgal-dev         # Voronoi cells (RBSN)
   zlib1g-dev          # CRC-32 of checkpoint files and inputs
   libsuitesparse-dev  # UMFPACK, called directly for the RBSN's kept symbolic analysis
+  libsundials-dev     # IDAS and serial vectors (>= 6), called directly by the RBSN's variable-order
+                      # analysis (libdeal.ii-dev depends on it too)
   libopenblas0-serial # an optimised BLAS/LAPACK behind libblas.so.3 (the sparse direct
                       # solvers' dense kernels; Debian's default is the reference BLAS)
   calculix-ccx        # benchmarks/calculix_cantilever_3d.py: the 3D FEM against CalculiX
