@@ -116,10 +116,16 @@ namespace hysteron
       }
     };
 
+    template <int dim>
+    class CellKernels;
+
     /// See the namespace documentation.
     template <int dim>
     class Solver : public Run::SteppingMethod<dim>
     {
+      /// The cell kernels of assemble() read the discretisation, loads and state.
+      friend class CellKernels<dim>;
+
     public:
       Solver();
       ~Solver() override;
