@@ -1,3 +1,4 @@
+#include <deal.II/base/exceptions.h>
 #include <deal.II/base/utilities.h>
 
 #include <deal.II/lac/vector.h>
@@ -230,7 +231,7 @@ namespace hysteron
               {
                 p[d] = dealii::Utilities::string_to_double(items[d]);
               }
-            catch (...)
+            catch (const dealii::ExceptionBase &)
               {
                 throw InputError(where, "cannot read the point '" + item + "'");
               }

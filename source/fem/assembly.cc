@@ -1,3 +1,6 @@
+// The FEM's global assembly: the discrete equations below, the WorkStream loop over the
+// locally owned cells that runs the cell kernels of cell_kernels.h on each and adds their
+// matrices and vectors into the global system, and the commit of a converged step.
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/multithread_info.h>
 #include <deal.II/base/timer.h>

@@ -1,3 +1,4 @@
+#include <deal.II/base/exceptions.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/numerics/data_out.h>
@@ -39,8 +40,11 @@ namespace hysteron
                   found           = true;
                 }
             }
-          catch (...)
-            {}
+          catch (const dealii::ExceptionBase &)
+            {
+              // GridTools' "point not found" or the mapping's failed inversion: the point
+              // is in none of this rank's cells (another rank may own it; none: below).
+            }
           probe.owner = Utilities::MPI::min(found ? rank : numbers::invalid_unsigned_int, comm);
           if (probe.owner == static_cast<int>(numbers::invalid_unsigned_int))
             {

@@ -1,6 +1,7 @@
 // Named sets in the FEM: the physical groups of a Gmsh mesh file (boundary faces or
 // cells with a tag, looked up by name or number) and the load-displacement histories
 // of `Output/History sets`.
+#include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/utilities.h>
 
@@ -68,8 +69,10 @@ namespace hysteron
         {
           tag = dealii::Utilities::string_to_int(group);
         }
-      catch (...)
-        {}
+      catch (const dealii::ExceptionBase &)
+        {
+          // Not a number: a name that the mesh does not have (below).
+        }
       require(tag > 0,
               where,
               "the mesh file " + file + " has no physical group named '" + group + "'; its named groups: " +

@@ -1,3 +1,4 @@
+#include <deal.II/base/exceptions.h>
 #include <deal.II/base/utilities.h>
 
 #include <hysteron/base/exceptions.h>
@@ -272,7 +273,7 @@ namespace hysteron
           {
             v[d] = dealii::Utilities::string_to_double(items[d]);
           }
-        catch (...)
+        catch (const dealii::ExceptionBase &)
           {
             throw InputError(where, "cannot read the number '" + items[d] + "'");
           }

@@ -1,3 +1,4 @@
+#include <deal.II/base/exceptions.h>
 #include <deal.II/base/utilities.h>
 
 #include <hysteron/base/config.h>
@@ -262,9 +263,9 @@ namespace hysteron
                   n   = dealii::Utilities::string_to_int(parts[1]);
                 }
             }
-          catch (...)
+          catch (const dealii::ExceptionBase &)
             {
-              ok = false;
+              ok = false; // not a number (deal.II's conversion)
             }
           require(ok && std::isfinite(end),
                   s.where("Steps"),
