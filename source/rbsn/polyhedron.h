@@ -26,6 +26,10 @@
  *   X n (A \ B)      = (X n A) \ B
  *   X \ (A u B)      = (X \ A) \ B
  *   X \ (A \ B)      = (X \ A) + ((X n A) n B).
+ *
+ * The shapes, their integrals and the box tree are in polyhedron.cc, the clipping
+ * in clipper.cc, the domain in polyhedral_domain.cc and its primitives in
+ * polyhedral_primitives.cc.
  */
 namespace hysteron
 {
@@ -106,6 +110,13 @@ namespace hysteron
         for (const auto &p : points)
           s += p;
         return Point(s / static_cast<double>(points.size()));
+      }
+
+      /// The unit vector along @p v != 0.
+      inline Vector
+      unit(const Vector &v)
+      {
+        return v / v.norm();
       }
 
       /**
@@ -252,6 +263,27 @@ namespace hysteron
         /// vertex lies beyond the tolerance on the other side, cut otherwise.
         Cut
         classify(const std::vector<Point> &vertices, const Plane &plane);
+
+        /// The steps of clip() for a polyhedron: the vertices kept and the faces cut at
+        /// the plane (returns the number of vertices kept), ...
+        unsigned int
+        cut_faces(const ConvexPolyhedron &in, ConvexPolyhedron &out);
+
+        /// ... the new vertex on the edge (a, b) (the same for both of its faces), ...
+        unsigned int
+        cut_vertex(const ConvexPolyhedron &in, const unsigned int a, const unsigned int b, ConvexPolyhedron &out);
+
+        /// ... the vertices on the plane (cap) merged where closer than the tolerance, ...
+        void
+        merge_cap_vertices(const unsigned int n_in, const unsigned int n_kept, ConvexPolyhedron &out);
+
+        /// ... the new face on the plane, tagged @p tag, ...
+        void
+        add_cap_face(const Plane &plane, const int tag, ConvexPolyhedron &out);
+
+        /// ... and the vertices that no face uses dropped.
+        void
+        drop_unused_vertices(ConvexPolyhedron &out);
 
         std::vector<double>                                   value;
         std::vector<int>                                      index;

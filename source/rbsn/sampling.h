@@ -152,8 +152,8 @@ namespace hysteron
       /**
        * The random points of one body in the blocks of a tiled network (a Poisson-disk
        * sampler restricted to a block, blocks.cc): built once per body, then called per
-       * block with the points known around the block. The 2D one is in tessellation.cc,
-       * the 3D one in tessellation_3d.cc (it keeps the body's polyhedral domain and the
+       * block with the points known around the block. The 2D one is in poisson_disk_2d.cc,
+       * the 3D one in poisson_disk_3d.cc (it keeps the body's polyhedral domain and the
        * forbidden balls of the boundary points).
        *
        * The constructor takes the network's fixed points (user and boundary points: the
