@@ -113,31 +113,22 @@ namespace hysteron
 
 
 
-    template class Region<2>;
-    template class Region<3>;
-    template struct FillLattice<2>;
-    template struct FillLattice<3>;
-    template std::vector<dealii::Point<2>>
-    fill(const Region<2> &, const FillLattice<2> &, unsigned int);
-    template std::vector<dealii::Point<3>>
-    fill(const Region<3> &, const FillLattice<3> &, unsigned int);
-    template std::vector<dealii::Point<2>>
-    fill<2>(const Region<2> &,
-              const FillLattice<2> &,
-              unsigned int,
-              const std::array<unsigned int, 2> &,
-              const std::array<unsigned int, 2> &,
-              const std::function<bool(const std::array<unsigned int, 2> &)> &);
-    template std::vector<dealii::Point<3>>
-    fill<3>(const Region<3> &,
-              const FillLattice<3> &,
-              unsigned int,
-              const std::array<unsigned int, 3> &,
-              const std::array<unsigned int, 3> &,
-              const std::function<bool(const std::array<unsigned int, 3> &)> &);
-    template double
-    fill_particle_volume(const FillLattice<2> &, unsigned int);
-    template double
-    fill_particle_volume(const FillLattice<3> &, unsigned int);
+#define HYSTERON_INSTANTIATE(dim)                                                               \
+  template struct FillLattice<dim>;                                                             \
+  template std::vector<dealii::Point<dim>> fill(const Region<dim> &,                            \
+                                                const FillLattice<dim> &,                       \
+                                                unsigned int);                                  \
+  template std::vector<dealii::Point<dim>> fill<dim>(                                           \
+    const Region<dim> &,                                                                        \
+    const FillLattice<dim> &,                                                                   \
+    unsigned int,                                                                               \
+    const std::array<unsigned int, dim> &,                                                      \
+    const std::array<unsigned int, dim> &,                                                      \
+    const std::function<bool(const std::array<unsigned int, dim> &)> &);                        \
+  template double fill_particle_volume(const FillLattice<dim> &, unsigned int);
+
+    HYSTERON_INSTANTIATE(2)
+    HYSTERON_INSTANTIATE(3)
+#undef HYSTERON_INSTANTIATE
   } // namespace Geometry
 } // namespace hysteron
