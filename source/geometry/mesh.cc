@@ -147,6 +147,235 @@ namespace hysteron
         std::array<CgalPoint, 3>    p;
         unsigned int                body;
       };
+
+      /**
+       * Check the size before any work: disks' sides and the estimated cell count (from the
+       * exact area of single-primitive bodies, else the bounding box). Returns the estimate.
+       */
+      double
+      checked_cell_estimate(const std::vector<const Region<2> *> &bodies,
+                            const double                           h,
+                            const double                           boundary_h,
+                            const std::string                     &where)
+      {
+        double area_estimate = 0;
+        for (unsigned int i = 0; i < bodies.size(); ++i)
+          {
+            for (const auto &q : bodies[i]->get_primitives())
+              if (q.kind == Region<2>::Kind::disk)
+                require(2 * M_PI * q.p[2] / boundary_h <= 1e6, where,
+                        body_name(bodies, i) + ": a disk of radius " + to_string(q.p[2]) +
+                          " needs more than 1e6 sides at h = " + to_string(boundary_h));
+            const auto box = bodies[i]->bounding_box().get_boundary_points();
+            area_estimate += (bodies[i]->get_program().size() == 1 ?
+                                bodies[i]->volume_estimate() :
+                                (box.second[0] - box.first[0]) * (box.second[1] - box.first[1]));
+          }
+        const double estimated_cells = cells_per_area_over_h2 * area_estimate / (h * h);
+        require(estimated_cells <= max_cells, where,
+                "the mesh at h = " + to_string(h) + " would have about " +
+                  to_string(estimated_cells) + " cells, more than the limit of " +
+                  to_string(max_cells));
+        return estimated_cells;
+      }
+
+      /// The constraints: all primitives' boundaries, clipped to the box [lo, hi].
+      void
+      insert_constraints(Triangulation                        &cdt,
+                         const std::vector<const Region<2> *> &bodies,
+                         const double                          boundary_h,
+                         const dealii::Point<2>               &lo,
+                         const dealii::Point<2>               &hi)
+      {
+        VertexHandle hint;
+        for (const auto *body : bodies)
+          for (auto segment : body->boundary_segments(boundary_h))
+            {
+              if (!clip(segment[0], segment[1], lo, hi))
+                continue;
+              const VertexHandle a = (hint == VertexHandle() ?
+                                        cdt.insert(CgalPoint(segment[0][0], segment[0][1])) :
+                                        cdt.insert(CgalPoint(segment[0][0], segment[0][1]),
+                                                   hint->face()));
+              const VertexHandle b =
+                cdt.insert(CgalPoint(segment[1][0], segment[1][1]), a->face());
+              if (a != b)
+                cdt.insert_constraint(a, b);
+              hint = b;
+            }
+      }
+
+      dealii::Point<2>
+      centroid(const Triangulation::Face_handle &f)
+      {
+        const CgalPoint &a = f->vertex(0)->point(), &b = f->vertex(1)->point(),
+                        &c = f->vertex(2)->point();
+        return dealii::Point<2>((a.x() + b.x() + c.x()) / 3, (a.y() + b.y() + c.y()) / 3);
+      }
+
+      /// The domain: triangles (each on one side of every constraint) whose centroid is in
+      /// a body; the tolerance only errs on the side of refining.
+      void
+      mark_domain(Triangulation &cdt, const std::vector<Region<2>> &bodies, const double tolerance)
+      {
+        for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f)
+          {
+            const dealii::Point<2> c      = centroid(f);
+            bool                   inside = false;
+            for (const auto &body : bodies)
+              inside = inside || body.contains(c, tolerance);
+            f->set_in_domain(inside);
+          }
+      }
+
+      /**
+       * Refine point by point (the same sequence as Mesher::refine_mesh()), with a cap on
+       * the vertices: features much smaller than h, e.g. two bodies that overlap in a
+       * sliver 1e-9 wide along a side, would otherwise need millions of tiny triangles.
+       * (Delaunay refinement is graded: a small isolated feature costs only a few vertices
+       * per halving of the size.)
+       */
+      void
+      refine(Triangulation &cdt, const double h, const double estimated_cells, const std::string &where)
+      {
+        Mesher mesher(cdt, Criteria(shape_bound, h));
+        mesher.init(/*domain_specified = */ true);
+        const std::size_t max_vertices = static_cast<std::size_t>(
+          std::min(max_cells / 4, std::max(1e5, 2 * estimated_cells)));
+        while (mesher.step_by_step_refine_mesh())
+          if (cdt.number_of_vertices() > max_vertices)
+            throw InputError(where,
+                             "the refinement at h = " + to_string(h) + " exceeded " +
+                               std::to_string(max_vertices) +
+                               " vertices: the bodies have features much smaller than h "
+                               "(nearly coincident boundaries, thin slivers between "
+                               "overlapping bodies); align their coordinates or use a "
+                               "smaller h");
+      }
+
+      /**
+       * The refined domain triangles whose centroid lies in a body (the first one that
+       * holds it), ordered along a Hilbert curve through their centroids (on a 2^20 grid
+       * over the box [lo, hi]), equal keys by their vertices.
+       */
+      std::vector<KeptTriangle>
+      kept_triangles(const Triangulation          &cdt,
+                     const std::vector<Region<2>> &bodies,
+                     const dealii::Point<2>       &lo,
+                     const dealii::Point<2>       &hi)
+      {
+        std::vector<const Region<2> *> classifiers;
+        for (const auto &body : bodies)
+          classifiers.push_back(&body);
+        const unsigned int order = 20;
+        const double       scale[2] = {(1u << order) / std::max(hi[0] - lo[0], 1e-300),
+                                       (1u << order) / std::max(hi[1] - lo[1], 1e-300)};
+        std::vector<KeptTriangle> kept;
+        for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f)
+          {
+            if (!f->is_in_domain())
+              continue;
+            const dealii::Point<2> c    = centroid(f);
+            const int              body = first_body<2>(classifiers, c);
+            if (body < 0)
+              continue;
+            KeptTriangle t;
+            unsigned int first = 0;
+            for (unsigned int k = 1; k < 3; ++k)
+              if (f->vertex(k)->point() < f->vertex(first)->point())
+                first = k;
+            for (unsigned int k = 0; k < 3; ++k)
+              {
+                t.v[k] = f->vertex((first + k) % 3);
+                t.p[k] = t.v[k]->point();
+              }
+            std::uint32_t xy[2];
+            for (unsigned int d = 0; d < 2; ++d)
+              xy[d] = static_cast<std::uint32_t>(std::min(
+                (1u << order) - 1.0, std::max(0.0, std::floor((c[d] - lo[d]) * scale[d]))));
+            t.key  = hilbert_index(order, xy[0], xy[1]);
+            t.body = static_cast<unsigned int>(body);
+            kept.push_back(t);
+          }
+        std::sort(kept.begin(), kept.end(), [](const KeptTriangle &s, const KeptTriangle &t) {
+          if (s.key != t.key)
+            return s.key < t.key;
+          return std::lexicographical_compare(s.p.begin(), s.p.end(), t.p.begin(), t.p.end());
+        });
+        return kept;
+      }
+
+      /**
+       * Three quadrilaterals per triangle (vertex, two edge midpoints, centroid; midpoints
+       * of shared edges shared), vertices numbered in order of first use.
+       *
+       * The lines are consistently oriented by construction, so there is no need for
+       * GridTools::consistently_order_cells() (a third of the run time): every line of the
+       * quads runs from a triangle vertex to an edge midpoint or from an edge midpoint to a
+       * centroid, and in each quad (v0, v1, v2, v3) = (vertex, midpoint, midpoint,
+       * centroid) deal.II's lines 0->2, 1->3, 0->1, 2->3 all point that way, whichever of
+       * the two quads sharing a line is asked. Counter-clockwise triangles give
+       * counter-clockwise (positive) quads.
+       */
+      CoarseMesh<2>
+      split_into_quadrilaterals(Triangulation &cdt, const std::vector<KeptTriangle> &kept)
+      {
+        CoarseMesh<2>          mesh;
+        constexpr unsigned int invalid = std::numeric_limits<unsigned int>::max();
+        for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
+          v->info() = invalid;
+        const auto index_of = [&mesh](const VertexHandle &v) {
+          if (v->info() == invalid)
+            {
+              v->info() = mesh.vertices.size();
+              mesh.vertices.emplace_back(v->point().x(), v->point().y());
+            }
+          return v->info();
+        };
+        std::map<std::pair<unsigned int, unsigned int>, unsigned int> midpoints;
+        const auto midpoint_of = [&](const unsigned int i, const unsigned int j) {
+          const auto key = std::make_pair(std::min(i, j), std::max(i, j));
+          const auto it  = midpoints.find(key);
+          if (it != midpoints.end())
+            return it->second;
+          const unsigned int m = mesh.vertices.size();
+          mesh.vertices.push_back(0.5 * (mesh.vertices[key.first] + mesh.vertices[key.second]));
+          midpoints.emplace(key, m);
+          return m;
+        };
+        mesh.cells.reserve(3 * kept.size());
+        for (const auto &t : kept)
+          {
+            const unsigned int a = index_of(t.v[0]), b = index_of(t.v[1]), c = index_of(t.v[2]);
+            const unsigned int ab = midpoint_of(a, b), bc = midpoint_of(b, c),
+                               ca = midpoint_of(c, a);
+            const unsigned int g  = mesh.vertices.size();
+            mesh.vertices.push_back(
+              dealii::Point<2>((t.p[0].x() + t.p[1].x() + t.p[2].x()) / 3,
+                               (t.p[0].y() + t.p[1].y() + t.p[2].y()) / 3));
+            // Counter-clockwise cycles (a, ab, g, ca), (b, bc, g, ab), (c, ca, g, bc)
+            // in deal.II's lexicographic order (0, 1, 3, 2 around the cell).
+            for (const std::array<unsigned int, 4> &q : {std::array<unsigned int, 4>{{a, ab, ca, g}},
+                                                         std::array<unsigned int, 4>{{b, bc, ab, g}},
+                                                         std::array<unsigned int, 4>{{c, ca, bc, g}}})
+              {
+                dealii::CellData<2> cell;
+                std::copy(q.begin(), q.end(), cell.vertices.begin());
+                cell.material_id = static_cast<dealii::types::material_id>(t.body);
+                mesh.cells.push_back(cell);
+              }
+          }
+#ifdef DEBUG
+        for (const auto &cell : mesh.cells)
+          {
+            const auto &p0 = mesh.vertices[cell.vertices[0]], &p1 = mesh.vertices[cell.vertices[1]],
+                       &p2 = mesh.vertices[cell.vertices[2]];
+            Assert((p1[0] - p0[0]) * (p2[1] - p0[1]) - (p1[1] - p0[1]) * (p2[0] - p0[0]) > 0,
+                   dealii::ExcInternalError());
+          }
+#endif
+        return mesh;
+      }
     } // namespace
 
 
@@ -157,196 +386,23 @@ namespace hysteron
                       const std::string                     &where,
                       const double                           boundary_h_in)
     {
-      const double boundary_h = boundary_h_in > 0 ? boundary_h_in : h;
-      using Kind          = Region<2>::Kind;
-      const auto [lo, hi] = checked_bounding_box(bodies, h, where);
+      const double boundary_h      = boundary_h_in > 0 ? boundary_h_in : h;
+      const auto [lo, hi]          = checked_bounding_box(bodies, h, where);
+      const double estimated_cells = checked_cell_estimate(bodies, h, boundary_h, where);
 
-      // Check the size before any work: disks' sides and the estimated cell count
-      // (from the exact area of single-primitive bodies, else the bounding box).
-      double area_estimate = 0;
-      for (unsigned int i = 0; i < bodies.size(); ++i)
-        {
-          for (const auto &q : bodies[i]->get_primitives())
-            if (q.kind == Kind::disk)
-              require(2 * M_PI * q.p[2] / boundary_h <= 1e6, where,
-                      body_name(bodies, i) + ": a disk of radius " + to_string(q.p[2]) +
-                        " needs more than 1e6 sides at h = " + to_string(boundary_h));
-          const auto box = bodies[i]->bounding_box().get_boundary_points();
-          area_estimate += (bodies[i]->get_program().size() == 1 ?
-                              bodies[i]->volume_estimate() :
-                              (box.second[0] - box.first[0]) * (box.second[1] - box.first[1]));
-        }
-      const double estimated_cells = cells_per_area_over_h2 * area_estimate / (h * h);
-      require(estimated_cells <= max_cells, where,
-              "the mesh at h = " + to_string(h) + " would have about " +
-                to_string(estimated_cells) + " cells, more than the limit of " +
-                to_string(max_cells));
-
+      // The bodies with their disks as the polygons of the constraints: the classification
+      // of the triangles then agrees with the mesh boundary.
       std::vector<Region<2>> polygonized;
       polygonized.reserve(bodies.size());
       for (const auto *body : bodies)
         polygonized.push_back(body->polygonized(boundary_h));
-      std::vector<const Region<2> *> classifiers;
-      for (const auto &p : polygonized)
-        classifiers.push_back(&p);
 
-      // 1. The constraints: all primitives' boundaries, clipped to the box.
       Triangulation cdt;
-      VertexHandle  hint;
-      for (const auto *body : bodies)
-        for (auto segment : body->boundary_segments(boundary_h))
-          {
-            if (!clip(segment[0], segment[1], lo, hi))
-              continue;
-            const VertexHandle a = (hint == VertexHandle() ?
-                                      cdt.insert(CgalPoint(segment[0][0], segment[0][1])) :
-                                      cdt.insert(CgalPoint(segment[0][0], segment[0][1]),
-                                                 hint->face()));
-            const VertexHandle b =
-              cdt.insert(CgalPoint(segment[1][0], segment[1][1]), a->face());
-            if (a != b)
-              cdt.insert_constraint(a, b);
-            hint = b;
-          }
+      insert_constraints(cdt, bodies, boundary_h, lo, hi);
       require(cdt.dimension() == 2, where, "the bodies' boundaries enclose no area");
-
-      // 2. The domain: triangles (each on one side of every constraint) whose
-      //    centroid is in a body; the tolerance only errs on the side of refining.
-      const double tolerance = 1e-6 * h;
-      const auto   centroid  = [](const Triangulation::Face_handle &f) {
-        const CgalPoint &a = f->vertex(0)->point(), &b = f->vertex(1)->point(),
-                        &c = f->vertex(2)->point();
-        return dealii::Point<2>((a.x() + b.x() + c.x()) / 3, (a.y() + b.y() + c.y()) / 3);
-      };
-      for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f)
-        {
-          const dealii::Point<2> c      = centroid(f);
-          bool                   inside = false;
-          for (const auto &body : polygonized)
-            inside = inside || body.contains(c, tolerance);
-          f->set_in_domain(inside);
-        }
-
-      // Refine point by point (the same sequence as Mesher::refine_mesh()), with a
-      // cap on the vertices: features much smaller than h, e.g. two bodies that
-      // overlap in a sliver 1e-9 wide along a side, would otherwise need millions
-      // of tiny triangles. (Delaunay refinement is graded: a small isolated
-      // feature costs only a few vertices per halving of the size.)
-      Mesher mesher(cdt, Criteria(shape_bound, h));
-      mesher.init(/*domain_specified = */ true);
-      const std::size_t max_vertices = static_cast<std::size_t>(
-        std::min(max_cells / 4, std::max(1e5, 2 * estimated_cells)));
-      while (mesher.step_by_step_refine_mesh())
-        if (cdt.number_of_vertices() > max_vertices)
-          throw InputError(where,
-                           "the refinement at h = " + to_string(h) + " exceeded " +
-                             std::to_string(max_vertices) +
-                             " vertices: the bodies have features much smaller than h "
-                             "(nearly coincident boundaries, thin slivers between "
-                             "overlapping bodies); align their coordinates or use a "
-                             "smaller h");
-
-      // 3. Keep the refined domain triangles whose centroid lies in a body.
-      const unsigned int order = 20;
-      const double       scale[2] = {(1u << order) / std::max(hi[0] - lo[0], 1e-300),
-                                     (1u << order) / std::max(hi[1] - lo[1], 1e-300)};
-      std::vector<KeptTriangle> kept;
-      for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f)
-        {
-          if (!f->is_in_domain())
-            continue;
-          const dealii::Point<2> c    = centroid(f);
-          const int              body = first_body<2>(classifiers, c);
-          if (body < 0)
-            continue;
-          KeptTriangle t;
-          unsigned int first = 0;
-          for (unsigned int k = 1; k < 3; ++k)
-            if (f->vertex(k)->point() < f->vertex(first)->point())
-              first = k;
-          for (unsigned int k = 0; k < 3; ++k)
-            {
-              t.v[k] = f->vertex((first + k) % 3);
-              t.p[k] = t.v[k]->point();
-            }
-          std::uint32_t xy[2];
-          for (unsigned int d = 0; d < 2; ++d)
-            xy[d] = static_cast<std::uint32_t>(std::min(
-              (1u << order) - 1.0, std::max(0.0, std::floor((c[d] - lo[d]) * scale[d]))));
-          t.key  = hilbert_index(order, xy[0], xy[1]);
-          t.body = static_cast<unsigned int>(body);
-          kept.push_back(t);
-        }
-      std::sort(kept.begin(), kept.end(), [](const KeptTriangle &s, const KeptTriangle &t) {
-        if (s.key != t.key)
-          return s.key < t.key;
-        return std::lexicographical_compare(s.p.begin(), s.p.end(), t.p.begin(), t.p.end());
-      });
-
-      // 4. Three quadrilaterals per triangle, vertices numbered in order of first use.
-      CoarseMesh<2>          mesh;
-      constexpr unsigned int invalid = std::numeric_limits<unsigned int>::max();
-      for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
-        v->info() = invalid;
-      const auto index_of = [&mesh](const VertexHandle &v) {
-        if (v->info() == invalid)
-          {
-            v->info() = mesh.vertices.size();
-            mesh.vertices.emplace_back(v->point().x(), v->point().y());
-          }
-        return v->info();
-      };
-      std::map<std::pair<unsigned int, unsigned int>, unsigned int> midpoints;
-      const auto midpoint_of = [&](const unsigned int i, const unsigned int j) {
-        const auto key = std::make_pair(std::min(i, j), std::max(i, j));
-        const auto it  = midpoints.find(key);
-        if (it != midpoints.end())
-          return it->second;
-        const unsigned int m = mesh.vertices.size();
-        mesh.vertices.push_back(0.5 * (mesh.vertices[key.first] + mesh.vertices[key.second]));
-        midpoints.emplace(key, m);
-        return m;
-      };
-      mesh.cells.reserve(3 * kept.size());
-      for (const auto &t : kept)
-        {
-          const unsigned int a = index_of(t.v[0]), b = index_of(t.v[1]), c = index_of(t.v[2]);
-          const unsigned int ab = midpoint_of(a, b), bc = midpoint_of(b, c),
-                             ca = midpoint_of(c, a);
-          const unsigned int g  = mesh.vertices.size();
-          mesh.vertices.push_back(
-            dealii::Point<2>((t.p[0].x() + t.p[1].x() + t.p[2].x()) / 3,
-                             (t.p[0].y() + t.p[1].y() + t.p[2].y()) / 3));
-          // Counter-clockwise cycles (a, ab, g, ca), (b, bc, g, ab), (c, ca, g, bc)
-          // in deal.II's lexicographic order (0, 1, 3, 2 around the cell).
-          for (const std::array<unsigned int, 4> &q : {std::array<unsigned int, 4>{{a, ab, ca, g}},
-                                                       std::array<unsigned int, 4>{{b, bc, ab, g}},
-                                                       std::array<unsigned int, 4>{{c, ca, bc, g}}})
-            {
-              dealii::CellData<2> cell;
-              std::copy(q.begin(), q.end(), cell.vertices.begin());
-              cell.material_id = static_cast<dealii::types::material_id>(t.body);
-              mesh.cells.push_back(cell);
-            }
-        }
-
-      // The lines are consistently oriented by construction, so there is no need
-      // for GridTools::consistently_order_cells() (a third of the run time): every
-      // line of the quads runs from a triangle vertex to an edge midpoint or from
-      // an edge midpoint to a centroid, and in each quad (v0, v1, v2, v3) =
-      // (vertex, midpoint, midpoint, centroid) deal.II's lines 0->2, 1->3, 0->1,
-      // 2->3 all point that way, whichever of the two quads sharing a line is asked.
-      // Counter-clockwise triangles give counter-clockwise (positive) quads.
-#ifdef DEBUG
-      for (const auto &cell : mesh.cells)
-        {
-          const auto &p0 = mesh.vertices[cell.vertices[0]], &p1 = mesh.vertices[cell.vertices[1]],
-                     &p2 = mesh.vertices[cell.vertices[2]];
-          Assert((p1[0] - p0[0]) * (p2[1] - p0[1]) - (p1[1] - p0[1]) * (p2[0] - p0[0]) > 0,
-                 dealii::ExcInternalError());
-        }
-#endif
-
+      mark_domain(cdt, polygonized, 1e-6 * h);
+      refine(cdt, h, estimated_cells, where);
+      CoarseMesh<2> mesh = split_into_quadrilaterals(cdt, kept_triangles(cdt, polygonized, lo, hi));
       check_cell_counts(bodies, mesh, h, where);
       return mesh;
     }

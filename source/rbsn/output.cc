@@ -1,63 +1,23 @@
+// The network's tables: the probes (located once) and the point tables with averages,
+// energies, reactions and set histories at every output, and springs.csv and cells.csv.
 #include <deal.II/base/mpi.h>
 
 #include <hysteron/base/output.h>
 #include <hysteron/rbsn/model.h>
 
 #include "rbsn/collective.h"
+#include "rbsn/rigid_motion.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdint>
 #include <limits>
-#include <map>
 #include <sstream>
 
 namespace hysteron
 {
   namespace RBSN
   {
-    namespace
-    {
-      /// The VTU's integer cell arrays (Int32), in write_vtu()'s order.
-      const std::vector<const char *> vtu_integer_fields{"cell", "facet", "body", "broken", "fragment", "released"};
-
-      /// Its real cell arrays (Float64): the rotation (2D: theta; 3D: the vector), H1 and
-      /// the facets' forces and stresses.
-      template <int dim>
-      std::vector<const char *>
-      vtu_real_fields()
-      {
-        if constexpr (dim == 2)
-          return {"rotation", "H1", "f_n", "f_t", "m", "s_n", "s_t"};
-        else
-          return {"rotation", "H1", "f_n", "f_1", "f_2", "m_1", "m_2", "m_t", "s_n", "s_t"};
-      }
-
-      /// The rigid motion u + theta x r of a cell with the DoF values @p U at the offset @p r.
-      template <int dim, typename Values>
-      dealii::Tensor<1, dim>
-      rigid_motion(const Values &U, const dealii::Tensor<1, dim> &r)
-      {
-        dealii::Tensor<1, dim> w;
-        if constexpr (dim == 2)
-          {
-            w[0] = U[0] - U[2] * r[1];
-            w[1] = U[1] + U[2] * r[0];
-          }
-        else
-          {
-            const dealii::Tensor<1, 3> theta({U[3], U[4], U[5]});
-            const dealii::Tensor<1, 3> turn = dealii::cross_product_3d(theta, r);
-            for (unsigned int d = 0; d < 3; ++d)
-              w[d] = U[d] + turn[d];
-          }
-        return w;
-      }
-    } // namespace
-
-
-
     template <int dim>
     std::vector<std::string>
     Model<dim>::point_columns() const
@@ -349,239 +309,6 @@ namespace hysteron
       tables.write(t, rows, averages,
                    {{kinetic, strain_energy, share * internal_work, share * external_work, share * boundary_work}},
                    reactions, comm, histories);
-    }
-
-
-
-    template <int dim>
-    void
-    Model<dim>::write_vtu(std::ostream &out) const
-    {
-      // The cells (2D: polygons; 3D: the convex polyhedra of each cell) moved rigidly
-      // (point data "displacement") and the facets (2D: lines; 3D: polygons), in one
-      // unstructured grid. Each rank writes its own cells and facets.
-      std::vector<dealii::Point<dim>>      points;
-      std::vector<double>                  displacement;
-      std::vector<std::int64_t>            offsets, connectivity, faces, face_offsets;
-      std::vector<std::uint8_t>            types;
-      std::array<std::vector<int>, 6>      integers; // cell, facet, body, broken, fragment, released
-      const std::vector<const char *>      reals_names = vtu_real_fields<dim>();
-      std::vector<std::vector<double>>     reals(reals_names.size());
-      constexpr unsigned int               n_rotation = dim == 2 ? 1 : 3;
-      const auto add_point = [&](const dealii::Point<dim> &p, const unsigned int c) {
-        std::array<double, n_dofs> U;
-        for (unsigned int k = 0; k < n_dofs; ++k)
-          U[k] = u.local_element(n_dofs * c + k);
-        const dealii::Tensor<1, dim> w = rigid_motion<dim>(U, p - local_nuclei[c]);
-        points.push_back(p);
-        for (unsigned int d = 0; d < dim; ++d)
-          displacement.push_back(w[d]);
-        return static_cast<std::int64_t>(points.size() - 1);
-      };
-      // H1 of a cell: the largest of its normal springs' (from the facets of every rank).
-      std::vector<double> cell_h1(cell_id.size(), 0.0);
-      for (unsigned int e = 0; e < springs.size(); ++e)
-        if (springs[e].hysteretic && !springs[e].broken)
-          for (const unsigned int c : {network.facets[e].a, network.facets[e].b})
-            cell_h1[c] = std::max(cell_h1[c], this->h1(e, 0));
-      if (distributed())
-        {
-          Vector h(partitioner);
-          for (unsigned int c = 0; c < cell_id.size(); ++c)
-            h.local_element(n_dofs * c) = cell_h1[c];
-          h.compress(dealii::VectorOperation::max);
-          for (unsigned int c = 0; c < n_owned_cells; ++c)
-            cell_h1[c] = h.local_element(n_dofs * c);
-        }
-      // The cell data of one VTK cell: the integer fields, the rotation (2D: theta; 3D:
-      // the vector) and the real fields after it.
-      std::vector<double> rotations;
-      const auto add_data = [&](const int cell, const int facet, const unsigned int body, const int broken,
-                                const unsigned int part, const bool loose, const double *rotation,
-                                const std::vector<double> &values) {
-        const int ints[6] = {cell, facet, int(body), broken, int(part), loose ? 1 : 0};
-        for (unsigned int k = 0; k < 6; ++k)
-          integers[k].push_back(ints[k]);
-        for (unsigned int k = 0; k < n_rotation; ++k)
-          rotations.push_back(rotation ? rotation[k] : 0.0);
-        for (unsigned int k = 1; k < values.size(); ++k)
-          reals[k].push_back(values[k]);
-      };
-      for (unsigned int c = 0; c < n_owned_cells; ++c)
-        {
-          std::vector<double> cell_values(reals_names.size(), 0.0);
-          double              rotation[n_rotation];
-          for (unsigned int k = 0; k < n_rotation; ++k)
-            rotation[k] = u.local_element(n_dofs * c + dim + k);
-          cell_values[1] = cell_h1[c];
-          const auto add_cell = [&]() {
-            add_data(cell_id[c], -1, cell_body[c], 0, fragment[c], released[c], rotation, cell_values);
-          };
-          if constexpr (dim == 2)
-            for (const auto &loop : network.cells[c].outline)
-              {
-                for (const auto &p : loop)
-                  connectivity.push_back(add_point(p, c));
-                offsets.push_back(connectivity.size());
-                types.push_back(7); // VTK_POLYGON
-                face_offsets.push_back(-1);
-                add_cell();
-              }
-          else
-            for (const auto &piece : network.cells[c].pieces)
-              {
-                // VTK_POLYHEDRON: its points, each once (its faces share them, so that its
-                // surface is closed for VTK: every edge in two faces), and its faces as
-                // (count, then per face the number of its points and their ids). The faces
-                // of a piece hold the same vertices bit for bit.
-                std::map<std::array<double, 3>, std::int64_t> ids;
-                faces.push_back(piece.size());
-                for (const auto &face : piece)
-                  {
-                    faces.push_back(face.size());
-                    for (const auto &p : face)
-                      {
-                        const auto [at, added] = ids.try_emplace({{p[0], p[1], p[2]}}, 0);
-                        if (added)
-                          {
-                            at->second = add_point(p, c);
-                            connectivity.push_back(at->second);
-                          }
-                        faces.push_back(at->second);
-                      }
-                  }
-                offsets.push_back(connectivity.size());
-                face_offsets.push_back(faces.size());
-                types.push_back(42);
-                add_cell();
-              }
-        }
-      // Every facet (moved with cell a): its spring forces, stresses and H1 (the largest
-      // of its springs'); broken ones have broken = 1 and no force.
-      for (unsigned int e = 0; e < springs.size(); ++e)
-        {
-          const Springs<dim> &sp = springs[e];
-          const Facet<dim>   &f  = network.facets[e];
-          std::vector<double> facet_values(reals_names.size(), 0.0);
-          double              largest = 0;
-          for (unsigned int i = 0; i < n_dofs; ++i)
-            largest = std::max(largest, this->h1(e, i));
-          facet_values[1] = largest;
-          if (!sp.broken)
-            {
-              for (unsigned int i = 0; i < n_dofs; ++i)
-                facet_values[2 + i] = sp.force[i];
-              if constexpr (dim == 2)
-                {
-                  const double area   = sp.thickness * f.length;
-                  facet_values[5]     = sp.force[0] / area;
-                  facet_values[6]     = sp.force[1] / area;
-                }
-              else
-                {
-                  facet_values[8] = sp.force[0] / sp.area;
-                  facet_values[9] = std::hypot(sp.force[1], sp.force[2]) / sp.area;
-                }
-            }
-          const auto add_facet = [&]() {
-            face_offsets.push_back(-1);
-            add_data(-1, facet_id[e], cell_body[f.a], sp.broken ? 1 : 0, fragment[f.a], released[f.a], nullptr,
-                     facet_values);
-          };
-          if constexpr (dim == 2)
-            {
-              connectivity.push_back(add_point(f.p3, f.a));
-              connectivity.push_back(add_point(f.p4, f.a));
-              offsets.push_back(connectivity.size());
-              types.push_back(3); // VTK_LINE
-              add_facet();
-            }
-          else
-            for (const auto &polygon : f.polygons)
-              {
-                for (const auto &p : polygon)
-                  connectivity.push_back(add_point(p, f.a));
-                offsets.push_back(connectivity.size());
-                types.push_back(7); // VTK_POLYGON
-                add_facet();
-              }
-        }
-      // VTK XML with inline binary arrays: base64 of a UInt64 byte count and the raw
-      // little-endian values (a 100,000-cell network writes in a fraction of the ASCII time).
-      out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
-             "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n<Piece "
-             "NumberOfPoints=\""
-          << points.size() << "\" NumberOfCells=\"" << types.size() << "\">\n<Points>\n";
-      std::vector<double> xyz, displacement_3d;
-      xyz.reserve(3 * points.size());
-      displacement_3d.reserve(3 * points.size());
-      for (unsigned int k = 0; k < points.size(); ++k)
-        for (unsigned int d = 0; d < 3; ++d)
-          {
-            xyz.push_back(d < dim ? points[k][d] : 0.0);
-            displacement_3d.push_back(d < dim ? displacement[dim * k + d] : 0.0);
-          }
-      const auto array = [&](const char *type, const char *name, const unsigned int components,
-                             const auto &data) {
-        out << "<DataArray type=\"" << type << "\"" << (name[0] ? " Name=\"" : "") << name
-            << (name[0] ? "\"" : "") << " NumberOfComponents=\"" << components
-            << "\" format=\"binary\">\n";
-        Output::write_base64_array(out, data);
-        out << "\n</DataArray>\n";
-      };
-      array("Float64", "", 3, xyz);
-      out << "</Points>\n<Cells>\n";
-      array("Int64", "connectivity", 1, connectivity);
-      array("Int64", "offsets", 1, offsets);
-      array("UInt8", "types", 1, types);
-      if (dim == 3)
-        {
-          array("Int64", "faces", 1, faces);
-          array("Int64", "faceoffsets", 1, face_offsets);
-        }
-      out << "</Cells>\n<PointData Vectors=\"displacement\">\n";
-      array("Float64", "displacement", 3, displacement_3d);
-      out << "</PointData>\n<CellData>\n";
-      for (unsigned int k = 0; k < vtu_integer_fields.size(); ++k)
-        array("Int32", vtu_integer_fields[k], 1, std::vector<std::int32_t>(integers[k].begin(), integers[k].end()));
-      for (unsigned int k = 0; k < reals_names.size(); ++k)
-        if (k == 0)
-          array("Float64", reals_names[k], n_rotation, rotations);
-        else
-          array("Float64", reals_names[k], 1, reals[k]);
-      out << "</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-    }
-
-
-
-    template <int dim>
-    void
-    Model<dim>::write_fields(const double t, Output::FieldWriter &writer)
-    {
-      if (!distributed())
-        return writer.write_serial([this](std::ostream &out) { write_vtu(out); }, t); // replicated
-      writer.write_pieces([this](std::ostream &out) { write_vtu(out); },
-                          [](std::ostream &out, const std::vector<std::string> &pieces) {
-                            // The record of the ranks' pieces: the arrays of write_vtu().
-                            out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" "
-                                   "version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-                                   "<PUnstructuredGrid GhostLevel=\"0\">\n<PPointData "
-                                   "Vectors=\"displacement\">\n<PDataArray type=\"Float64\" "
-                                   "Name=\"displacement\" NumberOfComponents=\"3\"/>\n</PPointData>\n"
-                                   "<PCellData>\n";
-                            for (const char *name : vtu_integer_fields)
-                              out << "<PDataArray type=\"Int32\" Name=\"" << name << "\" NumberOfComponents=\"1\"/>\n";
-                            const auto reals = vtu_real_fields<dim>();
-                            for (unsigned int k = 0; k < reals.size(); ++k)
-                              out << "<PDataArray type=\"Float64\" Name=\"" << reals[k]
-                                  << "\" NumberOfComponents=\"" << (dim == 3 && k == 0 ? 3 : 1) << "\"/>\n";
-                            out << "</PCellData>\n<PPoints>\n<PDataArray type=\"Float64\" "
-                                   "NumberOfComponents=\"3\"/>\n</PPoints>\n";
-                            for (const auto &piece : pieces)
-                              out << "<Piece Source=\"" << piece << "\"/>\n";
-                            out << "</PUnstructuredGrid>\n</VTKFile>\n";
-                          },
-                          t);
     }
 
 
