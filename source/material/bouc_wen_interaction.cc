@@ -290,7 +290,7 @@ namespace hysteron
 
 
     template <unsigned int N>
-    inline __attribute__((always_inline)) typename BoucWenInteraction<N>::Reduced
+    typename BoucWenInteraction<N>::Reduced
     BoucWenInteraction<N>::reduced(const Vector &w_tr,
                                    const Vector &d,
                                    const double  s,
