@@ -1,9 +1,10 @@
 #ifndef hysteron_source_material_bouc_wen_backward_euler_h
 #define hysteron_source_material_bouc_wen_backward_euler_h
 
-// The backward Euler integrator of the Bouc-Wen point kernels: the members of
-// BoucWenKernels::Law declared in bouc_wen_kernels.h (which includes this file at its end)
-// with the equations and scaling documented there.
+// The backward Euler integrator of the Bouc-Wen point kernels (residual and Jacobian,
+// scaling, Newton's method with continuation, the end state and the consistent tangent):
+// the members of BoucWenKernels::Law declared in bouc_wen_kernels.h (which includes this
+// file at its end) with the equations and scaling documented there.
 
 namespace hysteron
 {
@@ -70,9 +71,27 @@ namespace hysteron
         const double sl = dl != 0 ? sign(dl) : d.s_lambda;
         // d R_w / d dlambda
         it.gw = -c.kin_q / it.sigma_y1 - it.q1 * c.iso * sl / (it.sigma_y1 * it.sigma_y1);
-        if (!J)
-          return;
+        if (J)
+          jacobian(c, d, x, it, inv_q, nDe, deta, sn, *J);
+      }
 
+
+
+      template <StressState S, bool kinematic, bool degrading>
+      inline __attribute__((always_inline)) void
+      Law<S, kinematic, degrading>::jacobian(const Constants &c,
+                                             const BEData    &d,
+                                             const VecM      &x,
+                                             const Iterate   &it,
+                                             const double     inv_q,
+                                             const double     nDe,
+                                             const double     deta,
+                                             const double     sn,
+                                             MatM            &Jm)
+      {
+        const double *sigma = x.data();
+        const double  w     = x[i_w];
+        const double  dl    = it.dlambda;
         // dn_K / dsigma = 3/(2 q) (P_dev - 2/3 n n) restricted to K (symmetric).
         MatK Nk;
         for (unsigned int b = 0; b < K; ++b)
@@ -107,7 +126,6 @@ namespace hysteron
             Nsigma[a]    = ns;
           }
 
-        MatM &Jm = *J;
         Jm.fill(0.0);
         const double dwn_dw = w > 0 ? c.n * it.wn / w : 0.0;
         if (!degrading)
@@ -210,84 +228,6 @@ namespace hysteron
 
 
       template <StressState S, bool kinematic, bool degrading>
-      inline unsigned int
-      Law<S, kinematic, degrading>::radial_return(const Constants &c,
-                    VecN            &y,
-                    const BEData    &d,
-                    const VecK      &sigma_tr,
-                    const double     q_tr,
-                    const VecK      &n_tr,
-                    const double     nDe_tr,
-                    const double     sigma_y,
-                    double          &H1,
-                    MatK            *T)
-      {
-        const double mu      = 0.5 * c.two_mu;
-        const double b       = 3.0 * mu + c.kin_q;
-        const double lambda1 = 1.0 / (c.H + 3.0 * mu);
-        const double cc      = d.H2 * lambda1 * nDe_tr;
-        double       w       = std::min(1.0, q_tr / sigma_y);
-        double       wn = power(c, w), g = 0, dg = -1;
-        unsigned int iterations = 0;
-        while (true)
-          {
-            g  = q_tr - b * cc * wn - w * (sigma_y + c.iso * cc * wn);
-            dg = -c.n * (b * cc + c.iso * cc * w) * wn / w - sigma_y - c.iso * cc * wn;
-            if (std::abs(g) * c.inv_sigma_y0 <= c.tol)
-              break;
-            if (iterations == c.max_iterations || !std::isfinite(g))
-              {
-                std::ostringstream m;
-                m << "Bouc-Wen (backward Euler): the radial-return Newton iteration did not "
-                     "converge in "
-                  << iterations << " iterations (scaled residual " << std::abs(g) / c.sigma_y0
-                  << ", tolerance " << c.tol << ", trial q/sigma_y = " << q_tr / sigma_y
-                  << "). Reduce the strain increment or raise Material/Bouc-Wen/Tolerance.";
-                throw RuntimeError(m.str());
-              }
-            ++iterations;
-            const double w_new = w - g / dg;
-            w                  = w_new > 0 ? w_new : 0.5 * w; // safeguard (n < 1)
-            wn                 = power(c, w);
-          }
-        const double dl = cc * wn;
-        for (unsigned int a = 0; a < K; ++a)
-          y[a] = sigma_tr[a] - c.two_mu * dl * n_tr[a];
-        for (unsigned int f = 0; f < F; ++f)
-          y[i_epsp + f] += dl * n_tr[f];
-        y[i_eps_ps] += dl;
-        H1 = H1_of(c, std::max(q_tr - b * dl, 0.0), sigma_y + c.iso * dl);
-
-        if (T)
-          {
-            // N D deps = 3/(2 q) (dev(De) - 2/3 n (n : De)); N is symmetric.
-            VecK         NDe;
-            const double p = (d.De[0] + d.De[1] + d.De[2]) / 3.0;
-            for (unsigned int a = 0; a < K; ++a)
-              NDe[a] = 1.5 / q_tr * (d.De[a] - (a < 3 ? p : 0.0) - 2.0 / 3.0 * n_tr[a] * nDe_tr);
-            const double dg_dc = -b * wn - c.iso * w * wn;
-            VecK         ddl;
-            for (unsigned int a = 0; a < K; ++a)
-              {
-                const double dc = d.H2 * lambda1 * c.two_mu * (n_tr[a] + NDe[a]);
-                const double dw = -(c.two_mu * n_tr[a] + dg_dc * dc) / dg;
-                ddl[a]          = wn * dc + cc * c.n * wn / w * dw;
-              }
-            const double f = 1.5 / q_tr * c.two_mu * c.two_mu * dl;
-            for (unsigned int a = 0; a < K; ++a)
-              for (unsigned int e = 0; e < K; ++e)
-                {
-                  const double pdev = (a == e ? 1.0 : 0.0) - (a < 3 && e < 3 ? 1.0 / 3.0 : 0.0);
-                  (*T)[a][e]        = D_entry(c, a, e) - c.two_mu * n_tr[a] * ddl[e] -
-                               f * (pdev - 2.0 / 3.0 * n_tr[a] * n_tr[e]);
-                }
-          }
-        return iterations;
-      }
-
-
-
-      template <StressState S, bool kinematic, bool degrading>
       inline void
       Law<S, kinematic, degrading>::guess(const Constants &c, const BEData &d, VecM &x)
       {
@@ -376,15 +316,12 @@ namespace hysteron
 
 
       template <StressState S, bool kinematic, bool degrading>
-      inline unsigned int
-      Law<S, kinematic, degrading>::backward_euler(const Constants &c,
-                     VecN            &y,
-                     const VecK      &deps,
-                     double          &H1,
-                     double          &H2,
-                     MatK            *T)
+      inline __attribute__((always_inline)) typename Law<S, kinematic, degrading>::Trial
+      Law<S, kinematic, degrading>::begin_increment(const Constants &c,
+                                                    const VecN      &y,
+                                                    const VecK      &deps,
+                                                    BEData          &d)
       {
-        BEData d;
         for (unsigned int a = 0; a < K; ++a)
           d.sigma0[a] = y[a];
         apply_D(c, deps.data(), d.De.data());
@@ -395,107 +332,121 @@ namespace hysteron
         d.e_h0    = degrading ? y[i_e_h] : 0.0;
 
         // Elastic trial state and the loading direction.
-        const double eta0 = eta_of(c, d.eps_ps0);
-        VecK         sigma_tr;
+        Trial tr;
+        tr.eta0 = eta_of(c, d.eps_ps0);
         for (unsigned int a = 0; a < K; ++a)
-          sigma_tr[a] = d.sigma0[a] + d.De[a] / eta0;
-        VecF         dev;
-        const double q_tr =
-          relative_deviator(sigma_tr.data(), kinematic ? d.alpha0.data() : nullptr, dev);
-        VecK n_tr, Dn_tr;
+          tr.sigma[a] = d.sigma0[a] + d.De[a] / tr.eta0;
+        VecF dev;
+        tr.q = relative_deviator(tr.sigma.data(), kinematic ? d.alpha0.data() : nullptr, dev);
         for (unsigned int a = 0; a < K; ++a)
-          n_tr[a] = q_tr > 0 ? 1.5 * dev[G::full[a]] / q_tr : 0.0;
-        apply_D(c, n_tr.data(), Dn_tr.data());
-        const double nDe_tr   = dot<K>(n_tr.data(), d.De.data());
-        const double sigma_y0 = c.sigma_y0 + c.iso * d.eps_ps0;
-        d.H2                  = c.beta + c.gamma * sign(nDe_tr);
-        d.s_lambda            = sign(nDe_tr);
-        H2                    = d.H2;
-        {
-          VecF         dev0;
-          const double q0 =
-            relative_deviator(d.sigma0.data(), kinematic ? d.alpha0.data() : nullptr, dev0);
-          d.w_cap = 2.0 * std::max(1.0, std::max(q_tr, q0) / sigma_y0);
-          // With beta > gamma, nu_s H1 (beta - gamma) > 1 is the run-away regime of the
-          // law itself (Phi' = n:D:deps (1 - nu_s H1 H2) > 0 while unloading): keep
-          // the iterates below it.
-          const double nu0 = degrading ? 1.0 + c.c_nu_scaled * d.e_h0 : 1.0;
-          if (c.beta > c.gamma && nu0 > 0)
-            d.w_cap = std::min(d.w_cap, std::pow(nu0 * (c.beta - c.gamma), -1.0 / c.n));
-        }
+          tr.n[a] = tr.q > 0 ? 1.5 * dev[G::full[a]] / tr.q : 0.0;
+        tr.nDe     = dot<K>(tr.n.data(), d.De.data());
+        tr.sigma_y = c.sigma_y0 + c.iso * d.eps_ps0;
+        d.H2       = c.beta + c.gamma * sign(tr.nDe);
+        d.s_lambda = sign(tr.nDe);
 
-        if (q_tr == 0 || d.H2 == 0 || nDe_tr == 0)
-          {
-            // Exactly elastic: lambda' = 0 (H1 = 0, or H2 = 0, or n:D:deps = 0).
-            for (unsigned int a = 0; a < K; ++a)
-              y[a] = sigma_tr[a];
-            if (track_eps_zz)
-              y[i_eps_zz] += eta0 * (-c.nu / c.E * (y[0] - d.sigma0[0] + y[1] - d.sigma0[1]));
-            H1 = H1_of(c, q_tr, sigma_y0);
-            if (T)
-              for (unsigned int a = 0; a < K; ++a)
-                for (unsigned int b = 0; b < K; ++b)
-                  (*T)[a][b] = D_entry(c, a, b) / eta0;
-            return 0;
-          }
+        VecF         dev0;
+        const double q0 =
+          relative_deviator(d.sigma0.data(), kinematic ? d.alpha0.data() : nullptr, dev0);
+        d.w_cap = 2.0 * std::max(1.0, std::max(tr.q, q0) / tr.sigma_y);
+        // With beta > gamma, nu_s H1 (beta - gamma) > 1 is the run-away regime of the
+        // law itself (Phi' = n:D:deps (1 - nu_s H1 H2) > 0 while unloading): keep
+        // the iterates below it.
+        const double nu0 = degrading ? 1.0 + c.c_nu_scaled * d.e_h0 : 1.0;
+        if (c.beta > c.gamma && nu0 > 0)
+          d.w_cap = std::min(d.w_cap, std::pow(nu0 * (c.beta - c.gamma), -1.0 / c.n));
+        return tr;
+      }
 
-        if constexpr (S != StressState::plane_stress && !degrading)
-          if (nDe_tr > 0)
-            return radial_return(c, y, d, sigma_tr, q_tr, n_tr, nDe_tr, sigma_y0, H1, T);
 
-        // Newton from the trial-based guess for the whole increment; if it fails,
-        // continuation in the increment: solve the backward Euler problem for
-        // s deps, s = ds, 2 ds, ... -> 1, each from the previous solution. The result
-        // is the backward Euler solution of the whole increment in either case.
-        VecM                        x;
-        Iterate                     it;
-        VecM                        R;
-        const VecK                  De         = d.De;
-        unsigned int                iterations = 0;
-        std::array<unsigned int, M> pivot;
-        MatM                        J;
+
+      template <StressState S, bool kinematic, bool degrading>
+      inline __attribute__((always_inline)) void
+      Law<S, kinematic, degrading>::elastic_update(const Constants &c,
+                                                   VecN            &y,
+                                                   const BEData    &d,
+                                                   const Trial     &tr,
+                                                   double          &H1,
+                                                   MatK            *T)
+      {
+        for (unsigned int a = 0; a < K; ++a)
+          y[a] = tr.sigma[a];
+        if (track_eps_zz)
+          y[i_eps_zz] += tr.eta0 * (-c.nu / c.E * (y[0] - d.sigma0[0] + y[1] - d.sigma0[1]));
+        H1 = H1_of(c, tr.q, tr.sigma_y);
+        if (T)
+          for (unsigned int a = 0; a < K; ++a)
+            for (unsigned int b = 0; b < K; ++b)
+              (*T)[a][b] = D_entry(c, a, b) / tr.eta0;
+      }
+
+
+
+      template <StressState S, bool kinematic, bool degrading>
+      inline __attribute__((always_inline)) unsigned int
+      Law<S, kinematic, degrading>::solve(const Constants &c,
+                                          BEData          &d,
+                                          const Trial     &tr,
+                                          VecM            &x,
+                                          VecM            &R,
+                                          Iterate         &it)
+      {
+        const VecK   De         = d.De;
+        unsigned int iterations = 0;
         guess(c, d, x);
-        if (!newton(c, d, x, R, it, c.max_iterations, iterations))
+        if (newton(c, d, x, R, it, c.max_iterations, iterations))
+          return iterations;
+        VecM   x_done = x;
+        bool   have   = false;
+        double s_done = 0, ds = 0.25;
+        while (s_done < 1)
           {
-            VecM   x_done = x;
-            bool   have   = false;
-            double s_done = 0, ds = 0.25;
-            while (s_done < 1)
+            if (ds < 1e-6 || iterations > 20 * c.max_iterations)
               {
-                if (ds < 1e-6 || iterations > 20 * c.max_iterations)
-                  {
-                    std::ostringstream m;
-                    m << "Bouc-Wen (backward Euler): the local Newton iteration did not "
-                         "converge (tolerance "
-                      << c.tol << ", trial q/sigma_y = " << q_tr / sigma_y0
-                      << ", continuation stalled at " << s_done << " of the increment after "
-                      << iterations
-                      << " iterations). Reduce the strain increment or raise "
-                         "Material/Bouc-Wen/Tolerance.";
-                    throw RuntimeError(m.str());
-                  }
-                const double s_try = std::min(1.0, s_done + ds);
-                for (unsigned int a = 0; a < K; ++a)
-                  d.De[a] = s_try * De[a];
-                if (have)
-                  x = x_done;
-                else
-                  guess(c, d, x);
-                if (newton(c, d, x, R, it, c.max_iterations, iterations))
-                  {
-                    s_done = s_try;
-                    x_done = x;
-                    have   = true;
-                    ds *= 2;
-                  }
-                else
-                  ds *= 0.25;
+                std::ostringstream m;
+                m << "Bouc-Wen (backward Euler): the local Newton iteration did not "
+                     "converge (tolerance "
+                  << c.tol << ", trial q/sigma_y = " << tr.q / tr.sigma_y
+                  << ", continuation stalled at " << s_done << " of the increment after "
+                  << iterations
+                  << " iterations). Reduce the strain increment or raise "
+                     "Material/Bouc-Wen/Tolerance.";
+                throw RuntimeError(m.str());
               }
-            x = x_done;
-            evaluate(c, d, x, R, nullptr, it);
+            const double s_try = std::min(1.0, s_done + ds);
+            for (unsigned int a = 0; a < K; ++a)
+              d.De[a] = s_try * De[a];
+            if (have)
+              x = x_done;
+            else
+              guess(c, d, x);
+            if (newton(c, d, x, R, it, c.max_iterations, iterations))
+              {
+                s_done = s_try;
+                x_done = x;
+                have   = true;
+                ds *= 2;
+              }
+            else
+              ds *= 0.25;
           }
+        x = x_done;
+        evaluate(c, d, x, R, nullptr, it);
+        return iterations;
+      }
 
-        // The converged end state.
+
+
+      template <StressState S, bool kinematic, bool degrading>
+      inline __attribute__((always_inline)) void
+      Law<S, kinematic, degrading>::store_solution(const Constants &c,
+                                                   VecN            &y,
+                                                   const BEData    &d,
+                                                   const VecM      &x,
+                                                   const Iterate   &it,
+                                                   double          &H1,
+                                                   double          &H2)
+      {
         const double dl = it.dlambda;
         for (unsigned int a = 0; a < K; ++a)
           y[a] = x[a];
@@ -509,40 +460,89 @@ namespace hysteron
             it.eta1 * (-c.nu / c.E * (y[0] - d.sigma0[0] + y[1] - d.sigma0[1]) + dl * it.n[2]);
         H1 = H1_of(c, std::max(it.q1, 0.0), it.sigma_y1);
         H2 = it.H2;
+      }
 
-        if (T)
+
+
+      template <StressState S, bool kinematic, bool degrading>
+      inline __attribute__((always_inline)) void
+      Law<S, kinematic, degrading>::consistent_tangent(const Constants &c,
+                                                       const BEData    &d,
+                                                       const VecM      &x,
+                                                       VecM            &R,
+                                                       Iterate         &it,
+                                                       MatK            &T)
+      {
+        // Implicit function theorem: d x / d deps = -J^-1 dR/d deps (scaled).
+        std::array<unsigned int, M> pivot;
+        MatM                        J;
+        evaluate(c, d, x, R, &J, it);
+        scale_jacobian(c, J);
+        if (!lu_factorize<M>(J, pivot))
+          throw RuntimeError("Bouc-Wen (backward Euler): singular local Jacobian");
+        VecK dc_de; // d c / d deps = nu1 H2 lambda1 D n / eta1
+        for (unsigned int b = 0; b < K; ++b)
+          dc_de[b] = it.nu1 * it.H2 * it.lambda1 * it.Dn[b] / it.eta1;
+        for (unsigned int b = 0; b < K; ++b)
           {
-            // Implicit function theorem: d x / d deps = -J^-1 dR/d deps (scaled).
-            evaluate(c, d, x, R, &J, it);
-            scale_jacobian(c, J);
-            if (!lu_factorize<M>(J, pivot))
-              throw RuntimeError("Bouc-Wen (backward Euler): singular local Jacobian");
-            VecK dc_de; // d c / d deps = nu1 H2 lambda1 D n / eta1
-            for (unsigned int b = 0; b < K; ++b)
-              dc_de[b] = it.nu1 * it.H2 * it.lambda1 * it.Dn[b] / it.eta1;
-            for (unsigned int b = 0; b < K; ++b)
+            VecM col{};
+            for (unsigned int a = 0; a < K; ++a)
+              col[a] = -D_entry(c, a, b) / it.eta1;
+            if (!degrading)
               {
-                VecM col{};
+                const double ddl = it.wn * dc_de[b];
                 for (unsigned int a = 0; a < K; ++a)
-                  col[a] = -D_entry(c, a, b) / it.eta1;
-                if (!degrading)
-                  {
-                    const double ddl = it.wn * dc_de[b];
-                    for (unsigned int a = 0; a < K; ++a)
-                      col[a] += it.Dn[a] * ddl;
-                    col[i_w] = it.gw * ddl;
-                  }
-                else
-                  col[i_dl] = -it.wn * dc_de[b];
-                for (unsigned int i = 0; i < M; ++i)
-                  col[i] = -col[i] * inverse_scale(c, i);
-                lu_solve<M>(J, pivot, col.data());
-                for (unsigned int a = 0; a < K; ++a)
-                  (*T)[a][b] = col[a] * c.sigma_y0;
+                  col[a] += it.Dn[a] * ddl;
+                col[i_w] = it.gw * ddl;
               }
+            else
+              col[i_dl] = -it.wn * dc_de[b];
+            for (unsigned int i = 0; i < M; ++i)
+              col[i] = -col[i] * inverse_scale(c, i);
+            lu_solve<M>(J, pivot, col.data());
+            for (unsigned int a = 0; a < K; ++a)
+              T[a][b] = col[a] * c.sigma_y0;
           }
+      }
+
+
+
+      template <StressState S, bool kinematic, bool degrading>
+      inline unsigned int
+      Law<S, kinematic, degrading>::backward_euler(const Constants &c,
+                                                   VecN            &y,
+                                                   const VecK      &deps,
+                                                   double          &H1,
+                                                   double          &H2,
+                                                   MatK            *T)
+      {
+        BEData      d;
+        const Trial tr = begin_increment(c, y, deps, d);
+        H2             = d.H2;
+        if (tr.q == 0 || d.H2 == 0 || tr.nDe == 0)
+          {
+            // Exactly elastic: lambda' = 0 (H1 = 0, or H2 = 0, or n:D:deps = 0).
+            elastic_update(c, y, d, tr, H1, T);
+            return 0;
+          }
+
+        if constexpr (S != StressState::plane_stress && !degrading)
+          if (tr.nDe > 0)
+            return radial_return(c, y, d, tr.sigma, tr.q, tr.n, tr.nDe, tr.sigma_y, H1, T);
+
+        // Newton from the trial-based guess for the whole increment; if it fails,
+        // continuation in the increment: solve the backward Euler problem for
+        // s deps, s = ds, 2 ds, ... -> 1, each from the previous solution. The result
+        // is the backward Euler solution of the whole increment in either case.
+        VecM               x, R;
+        Iterate            it;
+        const unsigned int iterations = solve(c, d, tr, x, R, it);
+        store_solution(c, y, d, x, it, H1, H2);
+        if (T)
+          consistent_tangent(c, d, x, R, it, *T);
         return iterations;
       }
+
     } // namespace BoucWenKernels
   }   // namespace Material
 } // namespace hysteron

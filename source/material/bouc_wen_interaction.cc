@@ -290,6 +290,72 @@ namespace hysteron
 
 
     template <unsigned int N>
+    typename BoucWenInteraction<N>::Reduced
+    BoucWenInteraction<N>::reduced(const Vector &w_tr,
+                                   const Vector &d,
+                                   const double  s,
+                                   const double  H2,
+                                   const double  nu) const
+    {
+      const double mu = s * nu;
+      Reduced      v;
+      Vector       dw; // dw/dmu
+      for (unsigned int i = 0; i < N; ++i)
+        {
+          const double f = 1 / (1 + mu * c[i]);
+          v.w[i]         = w_tr[i] * f;
+          dw[i]          = -c[i] * v.w[i] * f;
+        }
+      v.phi2             = dot(v.w, v.w);
+      v.h1               = h1_of_squared(v.phi2);
+      v.P                = dot(v.w, d);
+      v.A                = weighted_square(c, v.w);
+      const double dphi2 = 2 * dot(v.w, dw);
+      const double dP    = dot(dw, d);
+      double       dA    = 0;
+      for (unsigned int i = 0; i < N; ++i)
+        dA += 2 * c[i] * v.w[i] * dw[i];
+      const double q  = v.h1 * v.P / v.A;
+      const double dq = 0.5 * n * v.h1 * dphi2 / v.phi2 * v.P / v.A +
+                        v.h1 * (dP * v.A - v.P * dA) / (v.A * v.A);
+      v.G  = s * (mu - H2 * q);
+      v.dG = 1 - H2 * dq;
+      return v;
+    }
+
+
+
+    template <unsigned int N>
+    void
+    BoucWenInteraction<N>::implicit_tangent(const Vector  &d,
+                                            const Reduced &v,
+                                            const double   H2,
+                                            Matrix        &dw_dd) const
+    {
+      // r(w, d) = w - w0 - d + H2 q C w, q = H1 (w . d) / (w^T C w), H1 = Phi^n:
+      //   dq/dw_j = H1 (n P / Phi^2 w_j + d_j - 2 P c_j w_j / A) / A,  dq/dd_j = H1 w_j / A,
+      //   dr/dw = I + H2 (C w (x) dq/dw + q C),   dr/dd = -I + H2 C w (x) dq/dd.
+      const Vector &w = v.w;
+      const double  q = v.h1 * v.P / v.A;
+      Matrix        J, R;
+      for (unsigned int i = 0; i < N; ++i)
+        for (unsigned int j = 0; j < N; ++j)
+          {
+            const double dq_dw =
+              v.h1 * (n * v.P / v.phi2 * w[j] + d[j] - 2 * v.P * c[j] * w[j] / v.A) / v.A;
+            const double dq_dd = v.h1 * w[j] / v.A;
+            J[i][j] = (i == j ? 1 + H2 * q * c[i] : 0.0) + H2 * c[i] * w[i] * dq_dw;
+            R[i][j] = (i == j ? -1.0 : 0.0) + H2 * c[i] * w[i] * dq_dd;
+          }
+      Matrix X;
+      if (!solve<N>(J, R, X))
+        fail("the local Jacobian is singular", w, d);
+      dw_dd = -X;
+    }
+
+
+
+    template <unsigned int N>
     unsigned int
     BoucWenInteraction<N>::backward_euler(Vector &w, const Vector &d, Matrix *dw_dd) const
     {
@@ -309,45 +375,14 @@ namespace hysteron
         }
 
       // The reduced equation in nu = s mu >= 0: G(nu) = s g(s nu) < 0 at nu = 0, and G > 0
-      // on the far side of the root. w(mu) = w_tr / (1 + mu c).
-      struct Value
-      {
-        double G, dG; ///< s g and dg/dmu (= dG/dnu)
-        Vector w;
-        double phi2, h1, P, A;
-      };
-      const auto evaluate = [&](const double nu) {
-        const double mu = s * nu;
-        Value        v;
-        Vector       dw; // dw/dmu
-        for (unsigned int i = 0; i < N; ++i)
-          {
-            const double f = 1 / (1 + mu * c[i]);
-            v.w[i]         = w_tr[i] * f;
-            dw[i]          = -c[i] * v.w[i] * f;
-          }
-        v.phi2            = dot(v.w, v.w);
-        v.h1              = h1_of_squared(v.phi2);
-        v.P               = dot(v.w, d);
-        v.A               = weighted_square(c, v.w);
-        const double dphi2 = 2 * dot(v.w, dw);
-        const double dP    = dot(dw, d);
-        double       dA    = 0;
-        for (unsigned int i = 0; i < N; ++i)
-          dA += 2 * c[i] * v.w[i] * dw[i];
-        const double q  = v.h1 * v.P / v.A;
-        const double dq = 0.5 * n * v.h1 * dphi2 / v.phi2 * v.P / v.A +
-                          v.h1 * (dP * v.A - v.P * dA) / (v.A * v.A);
-        v.G  = s * (mu - H2 * q);
-        v.dG = 1 - H2 * dq;
-        return v;
-      };
+      // on the far side of the root.
+      const auto evaluate = [&](const double nu) { return reduced(w_tr, d, s, H2, nu); };
 
       // The bracket [lo, hi], G(lo) < 0 <= G(hi). Loading: G -> +infinity as nu grows.
       // Unloading: nu < 1 (the pole of w at mu = -1 / max c_i = -1).
       const double nu_max = s > 0 ? std::numeric_limits<double>::infinity() : 1.0;
       double       lo = 0, hi = 0;
-      Value        v   = evaluate(0);
+      Reduced      v   = evaluate(0);
       // The explicit estimate of the root: nu ~ H2 Phi_tr^n |w_tr . d| / (w_tr^T C w_tr).
       // (capped where Phi_tr^n overflows or the estimate is far beyond the radial return,
       // nu = (Phi_tr - 1) / min c_i, which reaches Phi <= 1).
@@ -360,7 +395,7 @@ namespace hysteron
           double next = lo + step;
           if (next >= nu_max)
             next = 0.5 * (lo + nu_max);
-          const Value trial = evaluate(next);
+          const Reduced trial = evaluate(next);
           if (std::isnan(trial.G) || e == 200)
             fail("found no bracket of the root", w, d);
           if (trial.G >= 0)
@@ -402,27 +437,7 @@ namespace hysteron
       w = v.w;
 
       if (dw_dd)
-        {
-          // r(w, d) = w - w0 - d + H2 q C w, q = H1 (w . d) / (w^T C w), H1 = Phi^n:
-          //   dq/dw_j = H1 (n P / Phi^2 w_j + d_j - 2 P c_j w_j / A) / A,  dq/dd_j = H1 w_j / A,
-          //   dr/dw = I + H2 (C w (x) dq/dw + q C),   dr/dd = -I + H2 C w (x) dq/dd.
-          const double q = v.h1 * v.P / v.A;
-          Matrix       J, R;
-          for (unsigned int i = 0; i < N; ++i)
-            for (unsigned int j = 0; j < N; ++j)
-              {
-                const double dq_dw = v.h1 *
-                                     (n * v.P / v.phi2 * w[j] + d[j] - 2 * v.P * c[j] * w[j] / v.A) /
-                                     v.A;
-                const double dq_dd = v.h1 * w[j] / v.A;
-                J[i][j] = (i == j ? 1 + H2 * q * c[i] : 0.0) + H2 * c[i] * w[i] * dq_dw;
-                R[i][j] = (i == j ? -1.0 : 0.0) + H2 * c[i] * w[i] * dq_dd;
-              }
-          Matrix X;
-          if (!solve<N>(J, R, X))
-            fail("the local Jacobian is singular", w, d);
-          *dw_dd = -X;
-        }
+        implicit_tangent(d, v, H2, *dw_dd);
       return iterations;
     }
 

@@ -184,64 +184,26 @@ namespace hysteron
 
         /// out = D v (K vectors).
         static void
-        apply_D(const Constants &c, const double *v, double *out)
-        {
-          double tr = 0;
-          for (unsigned int a = 0; a < n_nor; ++a)
-            tr += v[a];
-          for (unsigned int a = 0; a < K; ++a)
-            out[a] = c.two_mu * v[a] + (a < n_nor ? c.lambda_eff * tr : 0.0);
-        }
+        apply_D(const Constants &c, const double *v, double *out);
 
         static double
-        D_entry(const Constants &c, const unsigned int a, const unsigned int b)
-        {
-          return (a == b ? c.two_mu : 0.0) + (a < n_nor && b < n_nor ? c.lambda_eff : 0.0);
-        }
+        D_entry(const Constants &c, const unsigned int a, const unsigned int b);
 
         template <unsigned int L>
         static double
-        dot(const double *a, const double *b)
-        {
-          double s = 0;
-          for (unsigned int i = 0; i < L; ++i)
-            s += a[i] * b[i];
-          return s;
-        }
+        dot(const double *a, const double *b);
 
         /// dev(xi), xi = embed(sigma) - alpha (alpha = nullptr: none); returns q.
         static double
-        relative_deviator(const double *sigma, const double *alpha, VecF &dev)
-        {
-          VecF xi{};
-          for (unsigned int a = 0; a < K; ++a)
-            xi[G::full[a]] = sigma[a];
-          if (alpha)
-            for (unsigned int f = 0; f < F; ++f)
-              xi[f] -= alpha[f];
-          const double p = (xi[0] + xi[1] + xi[2]) / 3.0;
-          dev            = xi;
-          dev[0] -= p;
-          dev[1] -= p;
-          dev[2] -= p;
-          return std::sqrt(1.5 * dot<F>(dev.data(), dev.data()));
-        }
+        relative_deviator(const double *sigma, const double *alpha, VecF &dev);
 
         /// eta(eps_ps) = (1 + (m_u + 1) c_eta eps_ps)^(1/(m_u + 1)), the closed-form
         /// solution of eta' = c_eta eta^(-m_u) eps_ps', eta(0) = 1.
         static double
-        eta_of(const Constants &c, const double eps_ps)
-        {
-          if (!degrading || c.c_eta == 0)
-            return 1.0;
-          return std::pow(1.0 + c.c_eta * eps_ps / c.inv_m_u1, c.inv_m_u1);
-        }
+        eta_of(const Constants &c, const double eps_ps);
 
         static double
-        H1_of(const Constants &c, const double q, const double sigma_y)
-        {
-          return q > 0 ? power(c, q / sigma_y) : 0.0;
-        }
+        H1_of(const Constants &c, const double q, const double sigma_y);
 
         /// What a rate evaluation knows besides the rates.
         struct Rates
@@ -264,61 +226,7 @@ namespace hysteron
 
         /// dy = f(y) for the strain increment deps (De = D deps).
         static void
-        rates(const Constants &c, const double *y, const VecK &De, double *dy, Rates &r)
-        {
-          VecF alpha;
-          if (kinematic)
-            for (unsigned int f = 0; f < F; ++f)
-              alpha[f] = c.kin * y[i_epsp + f];
-          VecF dev;
-          r.q       = relative_deviator(y, kinematic ? alpha.data() : nullptr, dev);
-          r.sigma_y = c.sigma_y0 + c.iso * y[i_eps_ps];
-          if (degrading)
-            {
-              r.eta = eta_of(c, y[i_eps_ps]);
-              r.nu  = 1.0 + c.c_nu_scaled * y[i_e_h];
-            }
-          double lambda_rate = 0;
-          if (r.q > 0)
-            {
-              const double inv_q = 1.5 / r.q;
-              for (unsigned int f = 0; f < F; ++f)
-                r.n[f] = inv_q * dev[f];
-              VecK n_K;
-              for (unsigned int a = 0; a < K; ++a)
-                n_K[a] = r.n[G::full[a]];
-              apply_D(c, n_K.data(), r.Dn.data());
-              const double nDn = dot<K>(n_K.data(), r.Dn.data());
-              const double nDe = dot<K>(n_K.data(), De.data());
-              r.H1             = H1_of(c, r.q, r.sigma_y);
-              r.H2             = c.beta + c.gamma * sign(nDe);
-              r.lambda1        = 1.0 / (c.H + nDn);
-              lambda_rate      = r.nu * r.H1 * r.H2 * r.lambda1 * nDe / r.eta;
-            }
-          else
-            {
-              r.n.fill(0.0);
-              r.Dn.fill(0.0);
-              r.H1      = 0;
-              r.H2      = c.beta;
-              r.lambda1 = 0;
-            }
-          const double inv_eta = 1.0 / r.eta;
-          for (unsigned int a = 0; a < K; ++a)
-            dy[a] = De[a] * inv_eta - lambda_rate * r.Dn[a];
-          for (unsigned int f = 0; f < F; ++f)
-            dy[i_epsp + f] = lambda_rate * r.n[f];
-          dy[i_eps_ps] = std::abs(lambda_rate);
-          if (degrading)
-            {
-              double sn = 0;
-              for (unsigned int a = 0; a < K; ++a)
-                sn += y[a] * r.n[G::full[a]];
-              dy[i_e_h] = lambda_rate * sn;
-            }
-          if (track_eps_zz)
-            dy[i_eps_zz] = r.eta * (-c.nu / c.E * (dy[0] + dy[1]) + dy[i_epsp + 2]);
-        }
+        rates(const Constants &c, const double *y, const VecK &De, double *dy, Rates &r);
 
         /**
          * dy = f(y) as rates(), for the stages of adaptive(): the rates only (no
@@ -339,124 +247,24 @@ namespace hysteron
                     const double    *y,
                     const VecK      &De,
                     double          *dy,
-                    Stage           *info = nullptr)
-        {
-          Stage st;
-          stage_begin(c, y, De, st);
-          stage_end(c, y, De, st, dy);
-          if (info)
-            *info = st;
-          return st.H1;
-        }
+                    Stage           *info = nullptr);
 
         /// The first part of stage_rates(): the deviator and the products with it
         /// (into @p st; everything up to the power and the divisions).
         static inline __attribute__((always_inline)) void
-        stage_begin(const Constants &c, const double *y, const VecK &De, Stage &st)
-        {
-          constexpr bool radial = S != StressState::plane_stress && !degrading;
-          // d and D d straight into st (a copy of local arrays was assembled on the
-          // stack with scalar stores and read back as pairs: store-forwarding stalls).
-          VecF        &d  = st.d;
-          const double q2 = deviator(c, y, d);
-          // D d and the products straight from d (no gathered copy of it).
-          VecK  &Dd  = st.Dd;
-          double dDd = 0, dDe = 0, tr = 0;
-          for (unsigned int a = 0; a < n_nor; ++a)
-            tr += d[G::full[a]];
-          for (unsigned int a = 0; a < K; ++a)
-            {
-              const double da = d[G::full[a]];
-              Dd[a]           = c.two_mu * da + (!radial && a < n_nor ? c.lambda_eff * tr : 0.0);
-              dDd += da * Dd[a];
-              dDe += da * De[a];
-            }
-          if (!radial)
-            st.dDd = dDd;
-          st.sigma_y = c.sigma_y0 + c.iso * y[i_eps_ps];
-          if (degrading)
-            {
-              st.eta = eta_of(c, y[i_eps_ps]);
-              st.nu  = 1.0 + c.c_nu_scaled * y[i_e_h];
-            }
-          st.dDe = dDe;
-          st.H2  = c.beta + c.gamma * sign(dDe);
-          st.q2  = q2;
-        }
+        stage_begin(const Constants &c, const double *y, const VecK &De, Stage &st);
 
         /// The second part of stage_rates(): H1, g and the rates dy.
         static inline __attribute__((always_inline)) void
-        stage_end(const Constants &c, const double *y, const VecK &De, Stage &st, double *dy)
-        {
-          constexpr bool radial = S != StressState::plane_stress && !degrading;
-          const double   q2 = st.q2, sigma_y = st.sigma_y, eta = st.eta, dDe = st.dDe;
-          const double   q  = std::sqrt(q2);
-          double         H1 = 0, g = 0;
-          if (c.n_half != 0 && radial)
-            {
-              const double inv_sy2 = 1.0 / (sigma_y * sigma_y);
-              double       t_m;
-              H1 = power_pair(q2 * inv_sy2, c.n_half, t_m);
-              g  = st.H2 * (t_m * inv_sy2) * dDe * c.radial_g; // d = 0: dDe = 0, g = 0
-              st.inv_sy2 = inv_sy2;
-            }
-          else if (c.n_half != 0)
-            {
-              // One division for 1 / sigma_y^2 and 1 / den: inv = 1 / (sigma_y^2 den).
-              const double den = q2 > 0 ? c.H * q2 + 2.25 * st.dDd : 1.0;
-              const double sy2 = sigma_y * sigma_y;
-              const double inv = 1.0 / (sy2 * den);
-              st.inv_sy2       = den * inv;
-              st.inv_den       = sy2 * inv;
-              H1               = integer_power(q2 * st.inv_sy2, c.n_half);
-              g = st.nu * H1 * st.H2 * 2.25 * dDe * st.inv_den / (degrading ? eta : 1.0);
-            }
-          else if (q2 > 0)
-            {
-              H1 = power(c, q / sigma_y);
-              g  = radial ? st.H2 * (H1 / q2) * dDe * c.radial_g :
-                            st.nu * H1 * st.H2 * 2.25 * dDe /
-                             ((degrading ? eta : 1.0) * (c.H * q2 + 2.25 * st.dDd));
-            }
-          for (unsigned int a = 0; a < K; ++a)
-            dy[a] = (degrading ? De[a] / eta : De[a]) - g * st.Dd[a];
-          for (unsigned int f = 0; f < F; ++f)
-            dy[i_epsp + f] = g * st.d[f];
-          dy[i_eps_ps] = std::abs(g) * q * (2.0 / 3.0);
-          if (degrading)
-            {
-              double sd = 0;
-              for (unsigned int a = 0; a < K; ++a)
-                sd += y[a] * st.d[G::full[a]];
-              dy[i_e_h] = g * sd;
-            }
-          if (track_eps_zz)
-            dy[i_eps_zz] = eta * (-c.nu / c.E * (dy[0] + dy[1]) + dy[i_epsp + 2]);
-          st.q  = q;
-          st.H1 = H1;
-        }
+        stage_end(const Constants &c, const double *y, const VecK &De, Stage &st, double *dy);
 
         /// E_t = (D - nu_s H1 H2 lambda1 (D n) (x) (D n)) / eta (eq. 2.47, Mandel).
         static void
-        continuum_tangent(const Constants &c, const Rates &r, MatK &T)
-        {
-          const double f = r.nu * r.H1 * r.H2 * r.lambda1;
-          for (unsigned int a = 0; a < K; ++a)
-            for (unsigned int b = 0; b < K; ++b)
-              T[a][b] = (D_entry(c, a, b) - f * r.Dn[a] * r.Dn[b]) / r.eta;
-        }
+        continuum_tangent(const Constants &c, const Rates &r, MatK &T);
 
         /// H1 at the state y.
         static double
-        H1_at(const Constants &c, const double *y)
-        {
-          VecF alpha, dev;
-          if (kinematic)
-            for (unsigned int f = 0; f < F; ++f)
-              alpha[f] = c.kin * y[i_epsp + f];
-          const double q = relative_deviator(y, kinematic ? alpha.data() : nullptr, dev);
-          return H1_of(c, q, c.sigma_y0 + c.iso * y[i_eps_ps]);
-        }
+        H1_at(const Constants &c, const double *y);
 
         /// One explicit step over the whole increment; r: the rates at the start.
         static void
@@ -492,23 +300,7 @@ namespace hysteron
         /// is stored once from registers; a local copy assembled on the stack and
         /// copied as a whole was read back as pairs and stalled on store forwarding.)
         static inline __attribute__((always_inline)) double
-        deviator(const Constants &c, const double *y, VecF &d)
-        {
-          VecF x;
-          for (unsigned int f = 0; f < F; ++f)
-            x[f] = kinematic ? -c.kin * y[i_epsp + f] : 0.0;
-          for (unsigned int a = 0; a < K; ++a)
-            x[G::full[a]] += y[a];
-          const double p  = (x[0] + x[1] + x[2]) * (1.0 / 3.0);
-          double       dd = 0;
-          for (unsigned int f = 0; f < F; ++f)
-            {
-              const double v = x[f] - (f < 3 ? p : 0.0);
-              d[f]           = v;
-              dd += v * v;
-            }
-          return 1.5 * dd;
-        }
+        deviator(const Constants &c, const double *y, VecF &d);
 
         /**
          * drift_correction() without degradation, in the q^2 form of stage_rates()
@@ -521,52 +313,7 @@ namespace hysteron
          * Sets r.H1 (r.q is left as it is: the caller stores H1 only).
          */
         static inline __attribute__((always_inline)) void
-        drift_correction_stage(const Constants &c, VecN &y, const Stage &stage, Rates &r)
-        {
-          constexpr bool radial = S != StressState::plane_stress;
-          VecF           d  = stage.d;
-          VecK           Dd = stage.Dd;
-          double         q2 = stage.q2, q = stage.q, sy = stage.sigma_y, dDd = stage.dDd;
-          for (unsigned int iteration = 0; iteration < 5; ++iteration)
-            {
-              // dlambda = (q - sigma_y) / slope, phi = 3/2 dlambda / q
-              // (The first step in plane stress reuses 1 / den of the stage.)
-              const double x = radial ? (q - sy) / (q * c.H_3mu) :
-                               (iteration == 0 && stage.inv_den != 0) ?
-                                        (q - sy) * q * stage.inv_den :
-                                        (q - sy) * q / (c.H * q2 + 2.25 * dDd);
-              const double phi = 1.5 * x;
-              for (unsigned int a = 0; a < K; ++a)
-                y[a] -= phi * Dd[a];
-              for (unsigned int f = 0; f < F; ++f)
-                y[i_epsp + f] += phi * d[f];
-              y[i_eps_ps] += x * q;
-              q2 = deviator(c, y.data(), d);
-              sy = c.sigma_y0 + c.iso * y[i_eps_ps];
-              if (!(q2 > sy * sy * (1 + 2e-14)))
-                break;
-              q = std::sqrt(q2);
-              VecK d_K;
-              for (unsigned int a = 0; a < K; ++a)
-                d_K[a] = d[G::full[a]];
-              if (radial)
-                for (unsigned int a = 0; a < K; ++a)
-                  Dd[a] = c.two_mu * d_K[a];
-              else
-                {
-                  apply_D(c, d_K.data(), Dd.data());
-                  dDd = dot<K>(d_K.data(), Dd.data());
-                }
-            }
-          // t = q^2 / sigma_y^2 without a division: sigma_y moved by the tiny
-          // r = (sigma_y - sigma_y,stage) / sigma_y,stage, and 1 / (1 + r)^2 =
-          // 1 - 2 r + 3 r^2 + O(r^3) (exact to round-off for |r| < 1e-6).
-          const double r_sy = (sy - stage.sigma_y) * stage.sigma_y * stage.inv_sy2;
-          const double t    = (stage.inv_sy2 != 0 && std::abs(r_sy) < 1e-6) ?
-                                q2 * (stage.inv_sy2 * (1.0 - r_sy * (2.0 - 3.0 * r_sy))) :
-                                q2 / (sy * sy);
-          r.H1 = c.n_half != 0 ? integer_power(t, c.n_half) : power(c, std::sqrt(t));
-        }
+        drift_correction_stage(const Constants &c, VecN &y, const Stage &stage, Rates &r);
 
         /**
          * The end of an accepted increment: the drift correction if nu_s H1 > 1.
@@ -581,36 +328,7 @@ namespace hysteron
                const VecK      &De,
                const Stage     &stage,
                Rates           &r,
-               const bool       full)
-        {
-          if (!full)
-            {
-              r.q       = stage.q;
-              r.sigma_y = stage.sigma_y;
-              r.H1      = stage.H1;
-              r.H2      = stage.H2;
-              r.nu      = stage.nu;
-              r.eta     = stage.eta;
-            }
-          // With strength deterioration the exact solution leaves nu_s H1 <= 1 (the
-          // saturation stress falls as e_h grows, and q follows it with a lag): no correction.
-          if (degrading && c.c_nu_scaled != 0)
-            return;
-          const double target = r.sigma_y * (degrading ? std::pow(r.nu, -1.0 / c.n) : 1.0);
-          if (!(r.q > target * (1 + 1e-14)))
-            return;
-          if (!full)
-            {
-              if constexpr (!degrading)
-                {
-                  drift_correction_stage(c, y, stage, r);
-                  return;
-                }
-              VecN dy;
-              rates(c, y.data(), De, dy.data(), r);
-            }
-          drift_correction(c, y, r);
-        }
+               const bool       full);
 
         /// Per-step error estimate of Bogacki-Shampine 3(2), scaled (error_norm()).
         static double
@@ -637,13 +355,7 @@ namespace hysteron
                     const VecN      &k1,
                     const VecN      &k4,
                     const double     H1_0,
-                    const double     H1_1)
-        {
-          const double hl = h * c.n * 1.5 * c.two_mu *
-                            std::max(k1[i_eps_ps], k4[i_eps_ps]) /
-                            (c.sigma_y0 + c.iso * y[i_eps_ps]);
-          return hl * hl * hl / 24 * std::abs(H1_1 - H1_0) / c.n * c.inv_tol;
-        }
+                    const double     H1_1);
 
         /**
          * The sub-step loop of adaptive() from s = 0 with the trial step @p h,
@@ -685,59 +397,7 @@ namespace hysteron
          */
         template <unsigned int P>
         static inline __attribute__((always_inline)) void
-        adaptive_points(const Constants &c, VecN *y, const VecK *deps, Rates *r)
-        {
-          VecK  De[P];
-          VecN  k1[P], k2[P], k3[P], k4[P], yt[P];
-          Stage st[P];
-          // One stage for all points: the deviators first, then the powers and
-          // divisions, which thus overlap.
-          const auto stage = [&](const VecN *x, VecN *k) {
-            for (unsigned int p = 0; p < P; ++p)
-              stage_begin(c, x[p].data(), De[p], st[p]);
-            for (unsigned int p = 0; p < P; ++p)
-              stage_end(c, x[p].data(), De[p], st[p], k[p].data());
-          };
-          for (unsigned int p = 0; p < P; ++p)
-            apply_D(c, deps[p].data(), De[p].data());
-          stage(y, k1);
-          double H1[P];
-          for (unsigned int p = 0; p < P; ++p)
-            {
-              H1[p] = st[p].H1;
-              for (unsigned int i = 0; i < N; ++i)
-                yt[p][i] = y[p][i] + 0.5 * k1[p][i];
-            }
-          stage(yt, k2);
-          for (unsigned int p = 0; p < P; ++p)
-            for (unsigned int i = 0; i < N; ++i)
-              yt[p][i] = y[p][i] + 0.75 * k2[p][i];
-          stage(yt, k3);
-          for (unsigned int p = 0; p < P; ++p)
-            for (unsigned int i = 0; i < N; ++i)
-              yt[p][i] =
-                y[p][i] + (2.0 / 9.0 * k1[p][i] + 1.0 / 3.0 * k2[p][i] + 4.0 / 9.0 * k3[p][i]);
-          stage(yt, k4);
-          for (unsigned int p = 0; p < P; ++p)
-            {
-              const double e  = bs32_error(c, 1.0, k1[p], k2[p], k3[p], k4[p]);
-              const double es =
-                e <= 1.0 ? stiff_error(c, 1.0, y[p], k1[p], k4[p], H1[p], st[p].H1) : 0.0;
-              if (es > 1.0)
-                substeps(c, y[p], De[p], k1[p], H1[p],
-                         std::max(0.2, 0.9 / std::sqrt(std::sqrt(es))), 1, r[p], false);
-              else if (e <= 1.0)
-                {
-                  y[p] = yt[p];
-                  finish(c, y[p], De[p], st[p], r[p], false);
-                }
-              else if (std::isfinite(e))
-                substeps(
-                  c, y[p], De[p], k1[p], H1[p], std::max(0.2, 0.9 / std::cbrt(e)), 1, r[p], false);
-              else // repeat the attempt in substeps(), which shortens or throws
-                substeps(c, y[p], De[p], k1[p], H1[p], 1.0, 0, r[p], false);
-            }
-        }
+        adaptive_points(const Constants &c, VecN *y, const VecK *deps, Rates *r);
 
         // ---------------------------------------------------------------
         // Backward Euler
@@ -786,8 +446,23 @@ namespace hysteron
           double nu1 = 1, H2 = 1;
         };
 
+        /// The residual R at x and the end-state quantities @p it; with @p J its
+        /// Jacobian dR/dx (unscaled).
         static void
         evaluate(const Constants &c, const BEData &d, const VecM &x, VecM &R, MatM *J, Iterate &it);
+
+        /// The Jacobian dR/dx of evaluate() at x, from the iterate @p it and evaluate()'s
+        /// 3 / (2 q), n:D:deps, d eta1 / d dlambda and sigma : n.
+        static inline __attribute__((always_inline)) void
+        jacobian(const Constants &c,
+                 const BEData    &d,
+                 const VecM      &x,
+                 const Iterate   &it,
+                 const double     inv_q,
+                 const double     nDe,
+                 const double     deta,
+                 const double     sn,
+                 MatM            &J);
 
         /// Scale of unknown / residual i: sigma_y0 (stresses), 1 (w), eps_y (dlambda),
         /// sigma_y0 eps_y (e_h). Newton solves the scaled system (unscaled, the
@@ -859,6 +534,43 @@ namespace hysteron
                const unsigned int max_iterations,
                unsigned int      &iterations);
 
+        /// The elastic trial state sigma_tr = sigma0 + D deps / eta0 of backward_euler(),
+        /// its flow direction n_tr (K components) and n_tr : D : deps.
+        struct Trial
+        {
+          VecK   sigma, n;
+          double eta0 = 1, q = 0, nDe = 0, sigma_y = 1;
+        };
+
+        /// The data of an increment (start state, D deps, H2 frozen from the trial
+        /// direction, the cap of w) and its elastic trial state.
+        static inline __attribute__((always_inline)) Trial
+        begin_increment(const Constants &c, const VecN &y, const VecK &deps, BEData &d);
+
+        /// The exactly elastic update (lambda' = 0) and its tangent D / eta0.
+        static inline __attribute__((always_inline)) void
+        elastic_update(const Constants &c, VecN &y, const BEData &d, const Trial &tr, double &H1, MatK *T);
+
+        /// Newton's method from guess() on the whole increment, else continuation in the
+        /// increment (d.De = s deps, s -> 1); returns the iterations, @p R and @p it at @p x.
+        static inline __attribute__((always_inline)) unsigned int
+        solve(const Constants &c, BEData &d, const Trial &tr, VecM &x, VecM &R, Iterate &it);
+
+        /// The converged end state into y, its H1 and H2.
+        static inline __attribute__((always_inline)) void
+        store_solution(const Constants &c,
+                       VecN            &y,
+                       const BEData    &d,
+                       const VecM      &x,
+                       const Iterate   &it,
+                       double          &H1,
+                       double          &H2);
+
+        /// The consistent tangent d sigma1 / d deps = -J^-1 dR/d deps (implicit function
+        /// theorem, on the scaled system).
+        static inline __attribute__((always_inline)) void
+        consistent_tangent(const Constants &c, const BEData &d, const VecM &x, VecM &R, Iterate &it, MatK &T);
+
         /**
          * Backward Euler over the increment deps: updates y (same layout as the
          * explicit integrators), writes H1, H2 and, if @p T is given, the
@@ -877,7 +589,9 @@ namespace hysteron
   }   // namespace Material
 } // namespace hysteron
 
+#include "material/bouc_wen_rates.h"
 #include "material/bouc_wen_explicit.h"
 #include "material/bouc_wen_backward_euler.h"
+#include "material/bouc_wen_radial_return.h"
 
 #endif

@@ -105,6 +105,213 @@ namespace hysteron
 
 
 
+    namespace
+    {
+      /**
+       * The layer of contact at one node: per body b, K = 1 + 4 dim values at q + b K:
+       * the mass m_b, the velocity (or momentum) v_b, the force f_b, the mass gradient
+       * g_b = sum_p m_p grad N_ip and the velocity projected from the points.
+       */
+      template <int dim>
+      struct NodeLayer
+      {
+        static constexpr unsigned int K = 1 + 4 * dim;
+        double *const                 q;
+        const unsigned int            B;
+
+        double *
+        body(const unsigned int b) const
+        {
+          return q + b * K;
+        }
+
+        double
+        mass(const unsigned int b) const
+        {
+          return q[b * K];
+        }
+
+        /// The mass gradient of body b, component d.
+        double
+        gradient(const unsigned int b, const unsigned int d) const
+        {
+          return q[b * K + 1 + 2 * dim + d];
+        }
+      };
+
+
+
+      /// The contact search at a node: how many bodies have mass there, and the first
+      /// rigid one among them (invalid_unsigned_int if none).
+      template <int dim>
+      std::pair<unsigned int, unsigned int>
+      bodies_at_node(const NodeLayer<dim>                      &node,
+                     const std::vector<BodyDescription<dim>> &bodies,
+                     const double                              tiny)
+      {
+        unsigned int n_bodies = 0, rigid = dealii::numbers::invalid_unsigned_int;
+        for (unsigned int b = 0; b < node.B; ++b)
+          if (node.mass(b) > tiny)
+            {
+              ++n_bodies;
+              if (bodies[b].rigid && rigid == dealii::numbers::invalid_unsigned_int)
+                rigid = b;
+            }
+        return {n_bodies, rigid};
+      }
+
+
+
+      /// One body at the node: its field is the common one @p r (after the boundary
+      /// conditions), value for value.
+      template <int dim>
+      void
+      copy_common_field(const NodeLayer<dim>                      &node,
+                        const double *const                       r,
+                        const std::vector<BodyDescription<dim>> &bodies,
+                        const bool                                record)
+      {
+        for (unsigned int b = 0; b < node.B; ++b)
+          if (!bodies[b].rigid)
+            {
+              double *const q = node.body(b);
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  q[1 + d] = r[1 + d];
+                  if (record)
+                    q[1 + dim + d] = r[1 + dim + d];
+                }
+            }
+      }
+
+
+
+      /**
+       * The outward normal of body b at a node, towards the other bodies (not
+       * normalised), from the nodal mass gradients g_c (g_c points out of body c: N_i
+       * falls away from node i). Against a rigid body its surface normal, n_b ~ -g_rigid
+       * (the material's own gradient turns at its corners and would lift a sliding
+       * body); between deformable bodies the average n_b ~ g_b - sum_{c != b} g_c, so that
+       * for two bodies n_a = -n_b and the pair's momentum is kept exactly.
+       */
+      template <int dim>
+      dealii::Tensor<1, dim>
+      outward_normal(const NodeLayer<dim>         &node,
+                     const unsigned int            b,
+                     const unsigned int            rigid,
+                     const dealii::Tensor<1, dim> &grad_total)
+      {
+        dealii::Tensor<1, dim> normal;
+        if (rigid != dealii::numbers::invalid_unsigned_int)
+          for (unsigned int d = 0; d < dim; ++d)
+            normal[d] = -node.gradient(rigid, d);
+        else
+          for (unsigned int d = 0; d < dim; ++d)
+            normal[d] = 2.0 * node.gradient(b, d) - grad_total[d];
+        return normal;
+      }
+
+
+
+      /// The heaviest body at the node other than @p b (the partner of its friction).
+      template <int dim>
+      unsigned int
+      heaviest_other(const NodeLayer<dim> &node, const unsigned int b)
+      {
+        unsigned int other    = dealii::numbers::invalid_unsigned_int;
+        double       heaviest = 0;
+        for (unsigned int c = 0; c < node.B; ++c)
+          if (c != b && node.mass(c) > heaviest)
+            {
+              heaviest = node.mass(c);
+              other    = c;
+            }
+        return other;
+      }
+
+
+
+      /**
+       * The contact impulse per unit mass of an approaching body (@p approach =
+       * relative . normal > 0, @p normal a unit vector): no interpenetration removes the
+       * approaching normal velocity; Coulomb reduces the tangential slip by at most
+       * mu times that normal change (stick when it suffices).
+       */
+      template <int dim>
+      dealii::Tensor<1, dim>
+      contact_correction(const dealii::Tensor<1, dim> &relative,
+                         const dealii::Tensor<1, dim> &normal,
+                         const double                  approach,
+                         const double                  mu)
+      {
+        const dealii::Tensor<1, dim> slip       = relative - approach * normal;
+        const double                 slip_v     = slip.norm();
+        dealii::Tensor<1, dim>       correction = approach * normal;
+        if (slip_v > 0)
+          correction += std::min(mu * approach, slip_v) / slip_v * slip;
+        return correction;
+      }
+      /// What the deformable bodies at a node add up to: their mass and the momentum of
+      /// their trial velocities; and the mass gradient of all bodies.
+      template <int dim>
+      struct NodeTotals
+      {
+        double                 mass = 0;
+        dealii::Tensor<1, dim> momentum, grad;
+      };
+
+
+
+      /**
+       * The trial velocity v_b of each deformable body at a node with two or more bodies:
+       * p_b / m_b (or the velocity the layer holds, if not @p holds_momenta), plus
+       * dt f_b / m_b after the momentum balance (@p record). At the first conversion of
+       * the layer the velocity projected from the points is kept, for the FLIP increment
+       * Delta v_b = v_b' - p_b / m_b (a correction at the step's start, USF, belongs to
+       * it too).
+       */
+      template <int dim>
+      NodeTotals<dim>
+      trial_velocities(const NodeLayer<dim>                      &node,
+                       const std::vector<BodyDescription<dim>> &bodies,
+                       const double                              tiny,
+                       const bool                                holds_momenta,
+                       const bool                                first_conversion,
+                       const double                              dt,
+                       const bool                                record,
+                       std::vector<dealii::Tensor<1, dim>>      &v)
+      {
+        NodeTotals<dim> total;
+        for (unsigned int b = 0; b < node.B; ++b)
+          {
+            double *const q = node.body(b);
+            for (unsigned int d = 0; d < dim; ++d)
+              total.grad[d] += q[1 + 2 * dim + d];
+            if (bodies[b].rigid)
+              continue;
+            if (!(q[0] > tiny))
+              {
+                for (unsigned int d = 0; d < dim; ++d)
+                  q[1 + d] = q[1 + dim + d] = 0;
+                continue;
+              }
+            const double inv_m = 1.0 / q[0];
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                const double v0 = holds_momenta ? q[1 + d] * inv_m : q[1 + d];
+                if (first_conversion)
+                  q[1 + 3 * dim + d] = v0;
+                v[b][d] = record ? v0 + dt * q[1 + dim + d] * inv_m : v0;
+              }
+            total.mass += q[0];
+            total.momentum += q[0] * v[b];
+          }
+        return total;
+      }
+    } // namespace
+
+
+
     template <int dim>
     void
     Solver<dim>::apply_contact(const double t, const double dt, const bool record)
@@ -113,8 +320,7 @@ namespace hysteron
       constexpr unsigned int C      = 1 + 2 * dim;
       constexpr unsigned int K      = contact_block;
       const unsigned int     B      = n_contact_blocks;
-      const std::size_t      L      = std::size_t(K) * B;
-      const double *const    node   = grid->data().data();
+      const double *const    common = grid->data().data();
       double *const          layer  = grid->layer_data().data();
       const double           tiny   = small_mass;
       const auto            &bodies = this->get_scene().body_descriptions();
@@ -126,74 +332,23 @@ namespace hysteron
           v_rigid[b] = bodies[b].rigid_velocity_at(t);
       const unsigned int first_rigid_reaction = boundaries.size();
 
-      // Per node: the trial velocity v_b' of each body with mass there.
       std::vector<Tensor<1, dim>> &v                = contact_velocity;
       const bool                   first_conversion = layer_from_points;
       for (const unsigned int n : active_nodes)
         {
-          double *const       q_n = layer + n * L;
-          const double *const r   = node + std::size_t(n) * C;
-
-          unsigned int n_bodies = 0, rigid = numbers::invalid_unsigned_int;
-          for (unsigned int b = 0; b < B; ++b)
-            if (q_n[b * K] > tiny)
-              {
-                ++n_bodies;
-                if (bodies[b].rigid && rigid == numbers::invalid_unsigned_int)
-                  rigid = b;
-              }
-
+          const NodeLayer<dim> node{layer + n * std::size_t(K) * B, B};
+          const double *const  r       = common + std::size_t(n) * C;
+          const auto [n_bodies, rigid] = bodies_at_node(node, bodies, tiny);
           if (n_bodies < 2)
             {
-              // One body at the node: its field is the common one (after the
-              // boundary conditions), value for value.
-              for (unsigned int b = 0; b < B; ++b)
-                if (!bodies[b].rigid)
-                  {
-                    double *const q = q_n + b * K;
-                    for (unsigned int d = 0; d < dim; ++d)
-                      {
-                        q[1 + d] = r[1 + d];
-                        if (record)
-                          q[1 + dim + d] = r[1 + dim + d];
-                      }
-                  }
+              copy_common_field(node, r, bodies, record);
               continue;
             }
 
-          // Two or more bodies. The trial velocity of each deformable body:
-          // v_b = p_b / m_b (or the velocity the layer holds), plus dt f_b / m_b
-          // after the momentum balance (record).
-          double         m_total = 0;
-          Tensor<1, dim> p_total, grad_total;
-          for (unsigned int b = 0; b < B; ++b)
-            {
-              double *const q = q_n + b * K;
-              for (unsigned int d = 0; d < dim; ++d)
-                grad_total[d] += q[1 + 2 * dim + d];
-              if (bodies[b].rigid)
-                continue;
-              if (!(q[0] > tiny))
-                {
-                  for (unsigned int d = 0; d < dim; ++d)
-                    q[1 + d] = q[1 + dim + d] = 0;
-                  continue;
-                }
-              const double inv_m = 1.0 / q[0];
-              for (unsigned int d = 0; d < dim; ++d)
-                {
-                  const double v0 = layer_holds_momenta ? q[1 + d] * inv_m : q[1 + d];
-                  // The velocity projected from the points, for the FLIP increment
-                  // Delta v_b = v_b' - p_b / m_b (a correction at the step's start, USF,
-                  // belongs to it too).
-                  if (first_conversion)
-                    q[1 + 3 * dim + d] = v0;
-                  v[b][d] = record ? v0 + dt * q[1 + dim + d] * inv_m : v0;
-                }
-              m_total += q[0];
-              p_total += q[0] * v[b];
-            }
-          if (!(m_total > tiny))
+          // Two or more bodies: each deformable one's trial velocity.
+          const NodeTotals<dim> total =
+            trial_velocities(node, bodies, tiny, layer_holds_momenta, first_conversion, dt, record, v);
+          if (!(total.mass > tiny))
             continue;
 
           // Boundary conditions act on the common field, i.e. on the centre of mass of
@@ -202,33 +357,21 @@ namespace hysteron
           Tensor<1, dim> shift;
           if (contact_boundary_node[n] && r[0] > tiny)
             for (unsigned int d = 0; d < dim; ++d)
-              shift[d] = r[1 + d] - p_total[d] / m_total;
+              shift[d] = r[1 + d] - total.momentum[d] / total.mass;
           // The velocity the bodies are measured against: a rigid body's (it does not
           // give way), else their centre of mass's.
-          const Tensor<1, dim> v_ref =
-            rigid != numbers::invalid_unsigned_int ? v_rigid[rigid] : p_total / m_total + shift;
+          const Tensor<1, dim> v_ref = rigid != numbers::invalid_unsigned_int ?
+                                         v_rigid[rigid] :
+                                         total.momentum / total.mass + shift;
 
           for (unsigned int b = 0; b < B; ++b)
             {
-              double *const q = q_n + b * K;
+              double *const q = node.body(b);
               if (bodies[b].rigid || !(q[0] > tiny))
                 continue;
               v[b] += shift;
-              // Outward normal of body b, towards the other bodies, from the nodal
-              // mass gradients g_c = sum_p m_p grad N_ip (g_c points out of body c:
-              // N_i falls away from node i). Against a rigid body its surface normal,
-              // n_b ~ -g_rigid (the material's own gradient turns at its corners and
-              // would lift a sliding body); between deformable bodies the average
-              // n_b ~ g_b - sum_{c != b} g_c, so that for two bodies n_a = -n_b and the
-              // pair's momentum is kept exactly.
-              Tensor<1, dim> normal;
-              if (rigid != numbers::invalid_unsigned_int)
-                for (unsigned int d = 0; d < dim; ++d)
-                  normal[d] = -q_n[rigid * K + 1 + 2 * dim + d];
-              else
-                for (unsigned int d = 0; d < dim; ++d)
-                  normal[d] = 2.0 * q[1 + 2 * dim + d] - grad_total[d];
-              const double length = normal.norm();
+              Tensor<1, dim> normal = outward_normal(node, b, rigid, total.grad);
+              const double   length = normal.norm();
               Tensor<1, dim> correction;
               if (length > 0)
                 {
@@ -237,26 +380,10 @@ namespace hysteron
                   const double         approach = relative * normal;
                   if (approach > 0)
                     {
-                      // No interpenetration: remove the approaching normal velocity;
-                      // Coulomb: the tangential slip is reduced by at most mu times
-                      // that normal change (stick when it suffices).
-                      unsigned int other = rigid;
-                      if (other == numbers::invalid_unsigned_int)
-                        {
-                          double heaviest = 0;
-                          for (unsigned int c = 0; c < B; ++c)
-                            if (c != b && q_n[c * K] > heaviest)
-                              {
-                                heaviest = q_n[c * K];
-                                other    = c;
-                              }
-                        }
-                      const double         mu      = friction[b * B + other];
-                      const Tensor<1, dim> slip    = relative - approach * normal;
-                      const double         slip_v  = slip.norm();
-                      correction                   = approach * normal;
-                      if (slip_v > 0)
-                        correction += std::min(mu * approach, slip_v) / slip_v * slip;
+                      const unsigned int other =
+                        rigid != numbers::invalid_unsigned_int ? rigid : heaviest_other(node, b);
+                      correction =
+                        contact_correction(relative, normal, approach, friction[b * B + other]);
                       v[b] -= correction;
                     }
                 }

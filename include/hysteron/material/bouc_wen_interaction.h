@@ -273,6 +273,24 @@ namespace hysteron
       Matrix
       tangent_w(const Vector &w, const Vector &d) const;
 
+      /// The reduced backward Euler equation of backward_euler() at nu = s mu >= 0:
+      /// w(mu) = w_tr / (1 + mu c), G(nu) = s g(s nu) and its derivative, and what the
+      /// tangent needs at w.
+      struct Reduced
+      {
+        double G, dG; ///< s g and dg/dmu (= dG/dnu)
+        Vector w;
+        double phi2, h1, P, A;
+      };
+
+      Reduced
+      reduced(const Vector &w_tr, const Vector &d, const double s, const double H2, const double nu)
+        const;
+
+      /// dw1/dd of the backward Euler solution v.w (implicit function theorem).
+      void
+      implicit_tangent(const Vector &d, const Reduced &v, const double H2, Matrix &dw_dd) const;
+
       unsigned int
       backward_euler(Vector &w, const Vector &d, Matrix *dw_dd) const;
 
