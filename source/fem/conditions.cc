@@ -18,6 +18,8 @@
 #include <hysteron/fem/fem.h>
 #include <hysteron/geometry/mesh.h>
 
+#include "base/implicit_step.h"
+
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -29,15 +31,11 @@ namespace hysteron
   {
     template <int dim>
     void
-    Solver<dim>::setup_dirichlet()
+    Solver<dim>::map_support_points(std::map<dealii::types::global_dof_index, dealii::Point<dim>> &support,
+                                    std::map<dealii::types::global_dof_index, unsigned int>       &component)
     {
-      using Type              = typename BoundaryDescription<dim>::Type;
-      const Scene<dim> &scene = this->get_scene();
-      const auto       &bodies = scene.body_descriptions();
-      std::map<dealii::types::global_dof_index, dealii::Point<dim>> support;
       dealii::DoFTools::map_dofs_to_support_points(*mapping, dof_handler, support);
-      std::map<dealii::types::global_dof_index, unsigned int> component;
-      std::vector<dealii::types::global_dof_index>            dofs(fe->n_dofs_per_cell());
+      std::vector<dealii::types::global_dof_index> dofs(fe->n_dofs_per_cell());
       for (const auto &cell : dof_handler.active_cell_iterators())
         if (!cell->is_artificial())
           {
@@ -55,6 +53,20 @@ namespace hysteron
             owned_support[owned_dofs.index_within_set(dof)]   = p;
             owned_component[owned_dofs.index_within_set(dof)] = component[dof];
           }
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::setup_dirichlet()
+    {
+      using Type              = typename BoundaryDescription<dim>::Type;
+      const Scene<dim> &scene = this->get_scene();
+      const auto       &bodies = scene.body_descriptions();
+      std::map<dealii::types::global_dof_index, dealii::Point<dim>> support;
+      std::map<dealii::types::global_dof_index, unsigned int>       component;
+      map_support_points(support, component);
 
       const double tolerance = 1e-9 * u_scale;
       dirichlet.clear();
@@ -174,16 +186,12 @@ namespace hysteron
     void
     Solver<dim>::make_constraints(const double t1, const bool predictor)
     {
-      constraints.clear();
-      constraints.reinit(relevant_dofs);
-      for (unsigned int k = 0; k < constrained_list.size(); ++k)
-        {
-          constraints.add_line(constrained_list[k]);
-          if (predictor)
-            constraints.set_inhomogeneity(constrained_list[k],
-                                          prescribed_increment(k, t1 - current_dt, t1));
-        }
-      constraints.close();
+      constrain_prescribed(constraints,
+                           relevant_dofs,
+                           constrained_list,
+                           predictor ? std::function<double(unsigned int)>(
+                                         [&](const unsigned int k) { return prescribed_increment(k, t1 - current_dt, t1); }) :
+                                       nullptr);
     }
 
 
@@ -292,6 +300,10 @@ namespace hysteron
 
 
 
+    template void Solver<2>::map_support_points(std::map<dealii::types::global_dof_index, dealii::Point<2>> &,
+                                                std::map<dealii::types::global_dof_index, unsigned int> &);
+    template void Solver<3>::map_support_points(std::map<dealii::types::global_dof_index, dealii::Point<3>> &,
+                                                std::map<dealii::types::global_dof_index, unsigned int> &);
     template void Solver<2>::setup_dirichlet();
     template void Solver<3>::setup_dirichlet();
     template void Solver<2>::make_constraints(const double, const bool);

@@ -296,6 +296,36 @@ namespace hysteron
 
 
     template <int dim>
+    double
+    Solver<dim>::project_on_walls(const double dt, Vector &v_half, std::vector<dealii::Tensor<1, dim>> &contact)
+    {
+      // Walls: x = X + u may not cross the wall plane. The impulse m dv of the
+      // projection is the wall's force times dt; a fixed wall does the work F . du with
+      // the node's displacement of the step (zero for a node that stays on it). The
+      // kinetic energy the projection removes (a perfectly inelastic contact of the node)
+      // is a loss that shows in the energy balance.
+      double wall_work = 0;
+      for (unsigned int k = 0; k < wall_dofs.size(); ++k)
+        {
+          const auto   dof  = wall_dofs[k];
+          const Wall  &w    = walls[wall_of_dof[k]];
+          const double x    = wall_reference[k] + u_trial(dof);
+          if (w.lower ? x < w.position : x > w.position)
+            {
+              const double corrected = w.position - wall_reference[k];
+              const double dv        = (corrected - u_trial(dof)) / dt;
+              u_trial(dof)           = corrected;
+              wall_work += lumped_mass(dof) * dv / dt * (corrected - u(dof));
+              v_half(dof) += dv;
+              contact[w.set][w.direction] += lumped_mass(dof) * dv / dt;
+            }
+        }
+      return wall_work;
+    }
+
+
+
+    template <int dim>
     void
     Solver<dim>::explicit_step(const double t, const double dt)
     {
@@ -321,28 +351,8 @@ namespace hysteron
       u_trial = u;
       u_trial.add(dt, v_half);
 
-      // Walls: x = X + u may not cross the wall plane. The impulse m dv of the
-      // projection is the wall's force times dt; a fixed wall does the work F . du with
-      // the node's displacement of the step (zero for a node that stays on it). The
-      // kinetic energy the projection removes (a perfectly inelastic contact of the node)
-      // is a loss that shows in the energy balance.
       std::vector<Tensor<1, dim>> contact(dirichlet.size());
-      double                      wall_work = 0;
-      for (unsigned int k = 0; k < wall_dofs.size(); ++k)
-        {
-          const auto   dof  = wall_dofs[k];
-          const Wall  &w    = walls[wall_of_dof[k]];
-          const double x    = wall_reference[k] + u_trial(dof);
-          if (w.lower ? x < w.position : x > w.position)
-            {
-              const double corrected = w.position - wall_reference[k];
-              const double dv        = (corrected - u_trial(dof)) / dt;
-              u_trial(dof)           = corrected;
-              wall_work += lumped_mass(dof) * dv / dt * (corrected - u(dof));
-              v_half(dof) += dv;
-              contact[w.set][w.direction] += lumped_mass(dof) * dv / dt;
-            }
-        }
+      const double                wall_work = project_on_walls(dt, v_half, contact);
       u_trial.compress(VectorOperation::insert);
       v_half.compress(VectorOperation::insert);
 

@@ -18,6 +18,8 @@
 #include <hysteron/fem/fem.h>
 #include <hysteron/geometry/mesh.h>
 
+#include "base/implicit_step.h"
+
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -99,6 +101,51 @@ namespace hysteron
                           "Every cell's Jacobian is checked: inverted (clockwise) cells are "
                           "repaired with a warning; self-intersecting and degenerate cells and "
                           "coincident nodes are refused with the element (doc/fem.md).");
+      }
+
+
+      /// The entries of `FEM/Linear solver`.
+      void
+      declare_linear_solver_parameters(dealii::ParameterHandler &prm)
+      {
+        using namespace dealii;
+        prm.declare_entry("Type",
+                          "automatic",
+                          Patterns::Selection("automatic|direct|cg|gmres"),
+                          "direct: Trilinos Amesos KLU; cg / gmres: with ML algebraic multigrid "
+                          "aggregated on the rigid-body modes of the mesh (translations and "
+                          "rotations); automatic: direct up "
+                          "to `Direct solver limit` DoFs, else CG if every material's tangent "
+                          "is symmetric, GMRES otherwise.");
+        prm.declare_entry("Direct solver package",
+                          "automatic",
+                          Patterns::Selection("automatic|Amesos_Klu|Amesos_Mumps"),
+                          "The Trilinos Amesos package of the direct solver: KLU (left-looking, "
+                          "no dense kernels: the fastest in 2D), MUMPS (multifrontal, on "
+                          "OpenBLAS: 2.6 times faster than KLU on a 3D Q2 cantilever of 11k "
+                          "DoFs) or automatic (the default): KLU in 2D, MUMPS in 3D. Under MPI "
+                          "MUMPS factorizes in parallel, and its results vary at round-off from "
+                          "run to run.");
+        prm.declare_entry("Direct solver limit",
+                          "100000",
+                          Patterns::Integer(1),
+                          "automatic: the largest number of DoFs solved directly.");
+        prm.declare_entry("Tolerance",
+                          "1e-10",
+                          Patterns::Double(),
+                          "Iterative solvers: relative residual reduction, > 0.");
+        prm.declare_entry("Preconditioner reuse",
+                          "true",
+                          Patterns::Bool(),
+                          "cg / gmres: keep the algebraic multigrid hierarchy over Newton "
+                          "iterations and increments while a solve takes at most twice the "
+                          "iterations (plus 10) of the first solve after its set-up; then, or "
+                          "when a solve fails, it is set up again from the current tangent. "
+                          "false: a new hierarchy for every solve.");
+        prm.declare_entry("Maximum iterations",
+                          "5000",
+                          Patterns::Integer(1),
+                          "Iterative solvers: iterations before the solve counts as failed.");
       }
     } // namespace
 
@@ -192,45 +239,7 @@ namespace hysteron
         prm.leave_subsection();
 
         prm.enter_subsection("Linear solver");
-        {
-          prm.declare_entry("Type",
-                            "automatic",
-                            Patterns::Selection("automatic|direct|cg|gmres"),
-                            "direct: Trilinos Amesos KLU; cg / gmres: with ML algebraic multigrid "
-                            "aggregated on the rigid-body modes of the mesh (translations and "
-                            "rotations); automatic: direct up "
-                            "to `Direct solver limit` DoFs, else CG if every material's tangent "
-                            "is symmetric, GMRES otherwise.");
-          prm.declare_entry("Direct solver package",
-                            "automatic",
-                            Patterns::Selection("automatic|Amesos_Klu|Amesos_Mumps"),
-                            "The Trilinos Amesos package of the direct solver: KLU (left-looking, "
-                            "no dense kernels: the fastest in 2D), MUMPS (multifrontal, on "
-                            "OpenBLAS: 2.6 times faster than KLU on a 3D Q2 cantilever of 11k "
-                            "DoFs) or automatic (the default): KLU in 2D, MUMPS in 3D. Under MPI "
-                            "MUMPS factorizes in parallel, and its results vary at round-off from "
-                            "run to run.");
-          prm.declare_entry("Direct solver limit",
-                            "100000",
-                            Patterns::Integer(1),
-                            "automatic: the largest number of DoFs solved directly.");
-          prm.declare_entry("Tolerance",
-                            "1e-10",
-                            Patterns::Double(),
-                            "Iterative solvers: relative residual reduction, > 0.");
-          prm.declare_entry("Preconditioner reuse",
-                            "true",
-                            Patterns::Bool(),
-                            "cg / gmres: keep the algebraic multigrid hierarchy over Newton "
-                            "iterations and increments while a solve takes at most twice the "
-                            "iterations (plus 10) of the first solve after its set-up; then, or "
-                            "when a solve fails, it is set up again from the current tangent. "
-                            "false: a new hierarchy for every solve.");
-          prm.declare_entry("Maximum iterations",
-                            "5000",
-                            Patterns::Integer(1),
-                            "Iterative solvers: iterations before the solve counts as failed.");
-        }
+        declare_linear_solver_parameters(prm);
         prm.leave_subsection();
       }
       prm.leave_subsection();
@@ -499,21 +508,11 @@ namespace hysteron
               if (increments.cut())
                 return false;
               n_cuts = increments.cuts();
-              std::ostringstream m;
-              m << "fem: Newton did not converge in the increment from t = " << t << " s to "
-                << t + dt << " s after " << newton.max_cuts << " cuts (increment " << dt
-                << " s = " << increments.nominal() << " s / 2^" << newton.max_cuts << ")";
-              m << ": the structure may have reached its limit load (use displacement "
-                   "control), or the increments or the tangent are poor (newton.csv has "
-                   "the residuals)";
-              if (!material_failure.empty())
-                m << "; the last failure was in the material: " << material_failure;
-              else
-                m << "; the last residual was " << system_rhs.l2_norm() / force_level()
-                  << " of the force level (tolerance "
-                  << std::max(newton.tolerance, residual_floor()) << ")";
-              m << ".";
-              throw Run::StepFailure(m.str());
+              const std::string cause =
+                !material_failure.empty() ?
+                  "the last failure was in the material: " + material_failure :
+                  residual_cause(system_rhs.l2_norm() / force_level(), std::max(newton.tolerance, residual_floor()));
+              throw Run::StepFailure(increment_failure("fem", t, dt, increments, {cause}));
             }
           commit(t + dt, dt);
         }

@@ -20,6 +20,8 @@
 #include <hysteron/fem/fem.h>
 #include <hysteron/geometry/mesh.h>
 
+#include "base/implicit_step.h"
+
 #include <Epetra_Map.h>
 #include <Epetra_MultiVector.h>
 #include <Teuchos_ParameterList.hpp>
@@ -161,61 +163,43 @@ namespace hysteron
     bool
     Solver<dim>::implicit_step(const double t, const double dt)
     {
-      const Scene<dim> &scene = this->get_scene();
-      MPI_Comm          comm  = scene.mpi_communicator();
-      const double      t1    = t + dt;
-      current_dt              = dt;
+      MPI_Comm     comm = this->get_scene().mpi_communicator();
+      const double t1   = t + dt;
+      current_dt        = dt;
       material_failure.clear();
-      Vector du(owned_dofs, comm), ghost(owned_dofs, relevant_dofs, comm);
-
-      // Predictor: the tangent of the converged state, the prescribed increments
-      // as inhomogeneous constraints (spreads the motion of the boundary over the body).
-      make_constraints(t1, true);
-      ghost = u;
-      if (!assemble(ghost, t1, dt, Assemble::residual_and_matrix, false))
-        return false;
-      // The out-of-balance force of the prescribed increments: the force level of a
-      // step that moves the body without loading it (a rigid motion).
-      predictor_level = system_rhs.l2_norm();
-      n_linear += solve_linear(du);
-      constraints.distribute(du);
-      make_constraints(t1, false);
-      u_trial = u;
-      u_trial += du;
-      ghost = u_trial;
-      if (!assemble(ghost, t1, dt, Assemble::residual_and_matrix))
-        return false;
-      log_newton(t1, dt, 0, system_rhs.l2_norm(), 1.0);
-
-      // The iterations (line search, round-off floor): base/newton.h.
-      VectorNewtonProblem<Vector> problem(
-        u_trial,
-        du,
-        {[&](const bool matrix) {
-           ghost = u_trial;
-           return assemble(ghost, t1, dt, matrix ? Assemble::residual_and_matrix : Assemble::forces);
-         },
-         [&]() { return system_rhs.l2_norm(); },
-         [&]() { return force_level(); },
-         [&](Vector &correction) {
-           correction = 0;
-           n_linear += solve_linear(correction);
-           constraints.distribute(correction);
-         },
-         [&](const unsigned int iteration, const double residual, const double alpha) {
-           log_newton(t1, dt, iteration, residual, alpha);
-         }});
+      Vector ghost(owned_dofs, relevant_dofs, comm);
+      // The predictor and Newton's iterations: base/implicit_step.h.
+      ImplicitIncrement<Vector> step;
+      step.newton = {[&](const bool matrix) {
+                       ghost = u_trial;
+                       return assemble(ghost, t1, dt, matrix ? Assemble::residual_and_matrix : Assemble::forces);
+                     },
+                     [&]() { return system_rhs.l2_norm(); },
+                     [&]() { return force_level(); },
+                     [&](Vector &correction) {
+                       correction = 0;
+                       n_linear += solve_linear(correction);
+                       constraints.distribute(correction);
+                     },
+                     [&](const unsigned int iteration, const double residual, const double alpha) {
+                       log_newton(t1, dt, iteration, residual, alpha);
+                     }};
+      step.constrain          = [&](const bool predictor) { make_constraints(t1, predictor); };
+      step.evaluate_predictor = [&]() {
+        ghost = u_trial;
+        return assemble(ghost, t1, dt, Assemble::residual_and_matrix, false);
+      };
       // The round-off of the residual that the iterate carries (base/newton.h): eps |K| |u|
       // (a free flight: rigid motion, no force). Updated Lagrangian: the strains are
       // differences of gradients of the full motion x = X + u, eps |K| (u_scale + |u|).
-      const double floor = std::max(residual_floor(),
-                                    iterate_floor(dof_handler.n_dofs(),
-                                                  system_matrix.linfty_norm(),
-                                                  (finite_strain ? u_scale : 0.0) + u_trial.linfty_norm(),
-                                                  force_level()));
-      const unsigned int iterations = newton_iterate(problem, newton, floor);
-      n_newton += iterations > 0 ? iterations : newton.max_iterations;
-      return iterations > 0;
+      step.floor = [&]() {
+        return std::max(residual_floor(),
+                        iterate_floor(dof_handler.n_dofs(),
+                                      system_matrix.linfty_norm(),
+                                      (finite_strain ? u_scale : 0.0) + u_trial.linfty_norm(),
+                                      force_level()));
+      };
+      return implicit_increment(u, u_trial, Vector(owned_dofs, comm), step, newton, predictor_level, n_newton);
     }
 
 

@@ -149,8 +149,12 @@ namespace hysteron
     void
     Model<dim>::VariableOrder::prescribed_velocities(const double t)
     {
+      // IDA takes no steps of the model's: a prescribed displacement's rate is the mean
+      // velocity of a step of 1e-8 of the end time from t (truncation and round-off of
+      // about that order).
+      const double h = 1e-8 * std::max(m.scene.time_control().end_time, 1e-300);
       for (unsigned int i = 0; i < n; ++i)
-        w[i] = m.dof_set[i] >= 0 ? m.prescribed_velocity(m.dirichlet[m.dof_set[i]], i, t) : 0.0;
+        w[i] = m.dof_set[i] >= 0 ? m.prescribed_velocity(m.dirichlet[m.dof_set[i]], i, t, h) : 0.0;
     }
 
 

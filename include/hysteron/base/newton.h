@@ -289,6 +289,13 @@ namespace hysteron
       return n_cuts;
     }
 
+    /// `Maximum increment cuts`.
+    unsigned int
+    cut_limit() const
+    {
+      return max_cuts;
+    }
+
     /// The state between increments (nominal step, level, successes, cuts), for a checkpoint.
     std::array<double, 4>
     state() const

@@ -312,6 +312,11 @@ namespace hysteron
       setup_system();
       void
       setup_history();
+      /// The support point and component of every DoF of the locally relevant cells, and
+      /// of every owned DoF (owned_support, owned_component).
+      void
+      map_support_points(std::map<dealii::types::global_dof_index, dealii::Point<dim>> &support,
+                         std::map<dealii::types::global_dof_index, unsigned int>       &component);
       void
       setup_dirichlet();
       /// Quasi-static: refuse a mesh part whose rigid-body motions are free (supports.cc).
@@ -454,6 +459,10 @@ namespace hysteron
       /// One explicit central-difference step from t to t + dt.
       void
       explicit_step(const double t, const double dt);
+      /// Project the nodes of u_trial that crossed a wall back onto it (v_half and the
+      /// walls' @p contact forces take the change of momentum); returns the walls' work.
+      double
+      project_on_walls(const double dt, Vector &v_half, std::vector<dealii::Tensor<1, dim>> &contact);
 
       /// Accept the trial state as converged (stresses, states, strains, work, vectors).
       void

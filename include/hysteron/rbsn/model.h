@@ -2,6 +2,7 @@
 #define hysteron_rbsn_model_h
 
 #include <deal.II/base/index_set.h>
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/partitioner.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/full_matrix.h>
@@ -19,6 +20,7 @@
 #include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>
 #include <hysteron/rbsn/spring_law.h>
+#include <hysteron/rbsn/springs.h>
 #include <hysteron/rbsn/tessellation.h>
 #include <hysteron/scene/method.h>
 #include <hysteron/scene/scene.h>
@@ -44,70 +46,6 @@ namespace hysteron
       template <int dim>
       class Nuclei;
     } // namespace Blocks
-
-    enum class Analysis
-    {
-      linear_static,     ///< elastic springs, one solve per step
-      quasi_static,      ///< Bouc-Wen springs, load stepping with Newton
-      implicit_dynamics, ///< Newmark / HHT-alpha with Newton
-      variable_order     ///< SUNDIALS IDA (variable-order BDF) on u, v and the spring states
-    };
-
-    /// Brittle fracture of the facets (eq. 3.49-3.51).
-    struct FractureParameters
-    {
-      bool   enabled          = false;
-      double tensile_strength = 0; ///< f_t [Pa]: the tension cut-off of the normal stress
-      double cohesion         = 0; ///< c [Pa]: the shear strength at zero normal stress
-      double friction         = 0; ///< tan of the friction angle
-      unsigned int max_cycles = 1000; ///< breaks within one step before the run stops
-    };
-
-    /// `subsection RBSN/Variable order`: SUNDIALS IDA (variable_order.cc).
-    struct VariableOrderParameters
-    {
-      double       relative_tolerance = 1e-6;
-      double       absolute_tolerance = 0; ///< [m] on the displacements; 0: automatic
-      unsigned int maximum_order      = 5; ///< of the BDF, 1..5
-      double       maximum_step       = 0; ///< [s]; 0: unlimited
-      double       initial_step       = 0; ///< [s]; 0: IDA's estimate
-    };
-
-    /**
-     * One facet's springs (2D: normal, tangential, rotational; 3D: normal, two shear,
-     * two bending, torsion; see FacetSprings): stiffness, the converged and trial
-     * deformations, forces and state of the spring law (see SpringLaw), and the tangent
-     * D = dF / d delta of the last evaluation. The deformations are delta = B U_e with
-     * U_e the two cells' DoFs (a's, then b's).
-     */
-    template <int dim>
-    struct Springs
-    {
-      static constexpr unsigned int n = n_springs<dim>; ///< springs (and DoFs per cell)
-      using Vector                    = typename SpringLaw<dim>::Vector;
-
-      Vector                          k{};
-      Vector                          delta{}, force{}, trial_delta{}, trial_force{};
-      typename SpringLaw<dim>::Matrix tangent; ///< diag(k) for linear springs
-      std::vector<double>             state, trial_state; ///< the law's (hysteretic springs only)
-      /// B: row i (spring), column k of U_e (a's n DoFs, then b's).
-      std::array<std::array<double, 2 * n>, n> B{};
-      double                                   thickness  = 1; ///< 2D: t [m]; 3D: 1
-      double                                   area       = 1; ///< the facet's area (2D: t l) [m^2]
-      bool                                     hysteretic = false; ///< the spring law's (else linear springs)
-      bool                                     broken     = false;
-
-      /// The deformation (or its rate) B_i U of spring i for the facet's DoF values @p U.
-      template <typename VectorType>
-      double
-      deformation(const unsigned int i, const VectorType &U) const
-      {
-        double s = 0;
-        for (unsigned int k = 0; k < 2 * n; ++k)
-          s += B[i][k] * U[k];
-        return s;
-      }
-    };
 
     /**
      * The scene on the network (see Solver), in 2D (cells with the DoFs u, v, theta)
@@ -261,12 +199,50 @@ namespace hysteron
       /// The box of the nuclei, the cells' bodies and the owned cells' mass properties.
       void
       setup_cells();
+      /// Parse `subsection RBSN` (the constructor).
+      void
+      parse_parameters(dealii::ParameterHandler &prm);
+      /// Refuse bodies the network cannot hold; the shapes of the others (the constructor).
+      void
+      check_bodies();
+      /// The springs of the owned facets: stiffnesses, B and the spring law (springs.cc).
       void
       setup_springs();
+      /// The stiffnesses and B of facet @p f between the cells of bodies @p ba and @p bb
+      /// (materials @p ma, @p mb) into @p sp and the spring law's @p facet.
+      void
+      spring_geometry(const Facet<dim>               &f,
+                      const BodyDescription<dim>     &ba,
+                      const BodyDescription<dim>     &bb,
+                      const Material::Interface<dim> &ma,
+                      const Material::Interface<dim> &mb,
+                      Springs<dim>                   &sp,
+                      FacetSprings<dim>              &facet) const;
+      /// The sparsity pattern and the solvers (linear_system.cc).
       void
       setup_system();
+      /// History sets, Dirichlet sets and loads (conditions.cc).
       void
       setup_conditions();
+      void
+      setup_history_sets();
+      /// The DoFs of every boundary condition and rigid body (a DoF belongs to the first).
+      void
+      setup_dirichlet();
+      void
+      setup_loads();
+      /// How close a nucleus must be to a face or region to be selected.
+      double
+      selection_tolerance() const
+      {
+        return 1e-9 * scale;
+      }
+      /// @p n summed over the network's ranks.
+      unsigned long
+      global_count(const std::size_t n) const
+      {
+        return dealii::Utilities::MPI::sum<unsigned long>(n, network_communicator());
+      }
       /// Static analyses: refuse a network part whose rigid-body motions are free (supports.cc).
       void
       check_supports() const;
@@ -309,9 +285,11 @@ namespace hysteron
       make_constraints(const double t0, const double t1, const bool predictor);
       /// The residual (and with @p matrix the tangent) at u_trial, time t1, step dt. The
       /// tangent is built from scratch, or (matrix_current) updated by the facets whose
-      /// tangent changed since it was assembled.
+      /// tangent changed since it was assembled (assembly.cc).
       bool
       assemble(const double t1, const double dt, const bool matrix, const bool update_springs);
+      /// One evaluation of assemble() (assembly.h).
+      class Assembly;
       /// The right-hand side of a local matrix and vector as
       /// distribute_local_to_global(K, r, dofs, matrix, rhs, true) makes it, without the matrix.
       void
@@ -386,6 +364,32 @@ namespace hysteron
       };
       Break
       facet_to_break() const;
+      /// The facets broken in the current attempt of an increment (since the converged
+      /// state): their number on every rank, the local ones, their fracture.csv rows and
+      /// the messages of the fragments they released.
+      struct Breaks
+      {
+        unsigned int                     n = 0;
+        std::vector<unsigned int>        local;
+        std::vector<std::vector<double>> rows;
+        std::vector<std::string>         messages;
+      };
+      /// Break facets and solve the step from @p t again until none has R > 1; false if
+      /// the step did not converge (fracture.cc).
+      bool
+      fracture_cycles(const double t, const double dt, Breaks &breaks);
+      /// Break @p broken at @p t1 (every rank); returns its midpoint.
+      dealii::Point<dim>
+      break_facet(const Break &broken, const double t1, Breaks &breaks);
+      /// The facets of @p breaks intact again.
+      void
+      undo_breaks(Breaks &breaks);
+      /// The rows and messages of @p breaks out.
+      void
+      write_breaks(Breaks &breaks);
+      /// Undo and write @p breaks, and stop the run with @p what.
+      [[noreturn]] void
+      fail_at_t(Breaks &breaks, const std::string &what);
       /// The fracture ratio R and the stresses s_n, s_t of facet @p e at its trial forces.
       std::array<double, 3>
       fracture_ratio(unsigned int e) const;
@@ -394,10 +398,12 @@ namespace hysteron
       /// The increment of prescribed local DoF @p dof of @p set from t0 to t1.
       double
       prescribed_increment(const Dirichlet &set, const unsigned int dof, const double t0, const double t1) const;
-      /// The velocity of a prescribed DoF of @p set at @p t (exact for velocities and rigid
-      /// bodies, a central difference of a prescribed displacement).
+      /// The velocity of a prescribed DoF of @p set at the start @p t of a step of length
+      /// @p dt: exact for velocities and rigid bodies, the step's mean velocity
+      /// (g(t + dt) - g(t)) / dt of a prescribed displacement g (the FEM's rule,
+      /// BoundaryDescription::step_velocity), 0 without a step.
       double
-      prescribed_velocity(const Dirichlet &set, const unsigned int dof, const double t) const;
+      prescribed_velocity(const Dirichlet &set, const unsigned int dof, const double t, const double dt) const;
       /// The mass matrix of owned cell @p c about its nucleus (eq. 3.12 and its 3D form).
       void
       cell_mass_matrix(const unsigned int c, dealii::FullMatrix<double> &M) const;
