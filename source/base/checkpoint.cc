@@ -27,7 +27,7 @@ namespace hysteron
   }
 
   void
-  CheckpointReader::section(const std::string &name)
+  CheckpointReader::section(const std::string &name, const std::uint32_t version)
   {
     std::string tag;
     const auto  n = get<std::uint64_t>();
@@ -36,8 +36,15 @@ namespace hysteron
              "')");
     tag.resize(n);
     read(tag.data(), n);
-    if (tag != "section:" + name)
-      refuse("expected the section '" + name + "', found '" + tag +
-             "': the checkpoint is of another method or version of hysteron");
+    if (tag == section_tag(name, version))
+      return;
+    // The same section in another format: name both versions (before versions: 1).
+    const std::string same = "section:" + name;
+    if (tag == same || tag.rfind(same + " v", 0) == 0)
+      refuse("its '" + name + "' state is in format version " +
+             (tag == same ? std::string("1") : tag.substr(same.size() + 2)) + ", this build of hysteron reads version " +
+             std::to_string(version) + ": resume it with the version of hysteron that wrote it, or start the run anew");
+    refuse("expected the section '" + name + "', found '" + tag +
+           "': the checkpoint is of another method or version of hysteron");
   }
 } // namespace hysteron

@@ -10,7 +10,7 @@
 // another number of ranks the partial sums are gathered on rank 0.
 #include <hysteron/fem/fem.h>
 
-#include "run/keyed_records.h"
+#include "run/record_archive.h"
 #include "run/rank_parts.h"
 
 #include <sstream>
@@ -35,6 +35,60 @@ namespace hysteron
           key = (key << dim) | child;
         return key << (dim * (level - id.get_child_indices().size()));
       }
+
+      /// The locally owned active cells and their keys, in the DoF handler's order.
+      template <int dim>
+      std::pair<std::vector<std::uint64_t>, std::vector<typename dealii::DoFHandler<dim>::active_cell_iterator>>
+      owned_cells(const dealii::DoFHandler<dim> &dof_handler)
+      {
+        const auto        &triangulation = dof_handler.get_triangulation();
+        const unsigned int level         = triangulation.n_global_levels() - 1;
+        std::pair<std::vector<std::uint64_t>, std::vector<typename dealii::DoFHandler<dim>::active_cell_iterator>> owned;
+        for (const auto &cell : dof_handler.active_cell_iterators())
+          if (cell->is_locally_owned())
+            {
+              owned.first.push_back(cell_key(cell->id(), dim, level));
+              owned.second.push_back(cell);
+            }
+        return owned;
+      }
+
+      /// The format of what this file stores: raise it with every change of a description below.
+      constexpr std::uint32_t format = 2;
+
+      /**
+       * One cell's record, for save and load alike: the cell's values of the
+       * @p n_vectors state vectors at its @p dofs, then its quadrature points' history.
+       * @p vectors gives get(j, i) (saving) and set(j, i, value) (loading) of entry i of
+       * vector j.
+       */
+      template <class Archive, class Vectors, int dim>
+      void
+      serialize_cell(Archive                                            &ar,
+                     const std::vector<dealii::types::global_dof_index> &dofs,
+                     Vectors                                            &vectors,
+                     CellHistory<dim>                                   &h)
+      {
+        for (unsigned int j = 0; j < vectors.size(); ++j)
+          for (const auto i : dofs)
+            {
+              double value = 0;
+              if constexpr (!Archive::is_loading)
+                value = vectors.get(j, i);
+              ar &value;
+              if constexpr (Archive::is_loading)
+                vectors.set(j, i, value);
+            }
+        const std::size_t n_q = h.stress.size(), n_state = h.state.size();
+        ar               &h;
+        if constexpr (Archive::is_loading)
+          {
+            if (h.stress.size() != n_q || h.strain.size() != n_q || h.state.size() != n_state ||
+                h.volume.size() != n_q || h.tangent.size() != n_q)
+              ar.refuse("a cell's state has another size than the scene's (another mesh, element or material)");
+            h.trial_volume = h.volume;
+          }
+      }
     } // namespace
 
 
@@ -44,7 +98,7 @@ namespace hysteron
     void
     Solver<dim>::serialize_global(Archive &ar)
     {
-      ar.section("fem");
+      ar.section("fem", format);
       auto increment_state = increments.state();
       ar &force_scale &last_force_level &predictor_level &current_dt &initial_kinetic &n_newton &n_cuts &n_linear
         &increment_state &step_checked;
@@ -60,7 +114,7 @@ namespace hysteron
     void
     Solver<dim>::serialize_rank(Archive &ar)
     {
-      ar.section("fem rank");
+      ar.section("fem rank", format);
       ar &internal_work &external_work &boundary_work &wall_forces;
     }
 
@@ -75,30 +129,36 @@ namespace hysteron
       self.serialize_rank(rank);
 
       // The cells' values of the vectors need their ghost entries.
-      MPI_Comm                           comm = this->get_scene().mpi_communicator();
-      std::vector<dealii::TrilinosWrappers::MPI::Vector> ghosted;
+      MPI_Comm comm = this->get_scene().mpi_communicator();
+      struct Ghosted
+      {
+        std::vector<dealii::TrilinosWrappers::MPI::Vector> x;
+        std::size_t
+        size() const
+        {
+          return x.size();
+        }
+        double
+        get(const unsigned int j, const dealii::types::global_dof_index i) const
+        {
+          return x[j](i);
+        }
+      } ghosted;
       for (Vector *x : self.state_vectors())
         {
-          ghosted.emplace_back(owned_dofs, relevant_dofs, comm);
-          ghosted.back() = *x;
+          ghosted.x.emplace_back(owned_dofs, relevant_dofs, comm);
+          ghosted.x.back() = *x;
         }
-      const unsigned int level = triangulation->n_global_levels() - 1;
-      std::vector<std::pair<std::uint64_t, std::string>> records;
-      std::vector<dealii::types::global_dof_index>       dofs(fe->n_dofs_per_cell());
-      for (const auto &cell : dof_handler.active_cell_iterators())
-        if (cell->is_locally_owned())
-          {
-            std::ostringstream bytes;
-            CheckpointWriter   out(bytes);
-            cell->get_dof_indices(dofs);
-            for (const auto &x : ghosted)
-              for (const auto i : dofs)
-                out.put(x(i));
-            out & *cell_history[cell->active_cell_index()];
-            records.emplace_back(cell_key(cell->id(), dim, level), bytes.str());
-          }
+      const auto owned = owned_cells(dof_handler);
+      const auto &keys = owned.first;
+      const auto &cells = owned.second;
+      std::vector<dealii::types::global_dof_index> dofs(fe->n_dofs_per_cell());
+      const unsigned int level  = triangulation->n_global_levels() - 1;
       const std::uint64_t n_keys = std::uint64_t(triangulation->n_global_coarse_cells()) << (dim * level);
-      Run::write_records(directory.file("cells"), n_keys, records, comm);
+      Run::save_records(directory.file("cells"), n_keys, keys, comm, [&](CheckpointWriter &out, const std::size_t k) {
+        cells[k]->get_dof_indices(dofs);
+        serialize_cell(out, dofs, ghosted, *cell_history[cells[k]->active_cell_index()]);
+      });
     }
 
 
@@ -119,42 +179,34 @@ namespace hysteron
                               internal_work, external_work, boundary_work, wall_forces);
         }
 
-      const unsigned int                   level = triangulation->n_global_levels() - 1;
-      std::vector<std::uint64_t>           keys;
-      std::vector<typename dealii::DoFHandler<dim>::active_cell_iterator> cells;
-      for (const auto &cell : dof_handler.active_cell_iterators())
-        if (cell->is_locally_owned())
-          {
-            keys.push_back(cell_key(cell->id(), dim, level));
-            cells.push_back(cell);
-          }
-      const auto records = Run::read_records(directory.file("cells"), keys, this->get_scene().mpi_communicator());
-      const auto vectors = state_vectors();
+      // Each owned cell's values go into the owned entries (the cells that share a DoF
+      // hold the same value).
+      struct Owned
+      {
+        std::array<Vector *, 10> x;
+        const dealii::IndexSet  &owned;
+        std::size_t
+        size() const
+        {
+          return x.size();
+        }
+        void
+        set(const unsigned int j, const dealii::types::global_dof_index i, const double value)
+        {
+          if (owned.is_element(i))
+            (*x[j])(i) = value;
+        }
+      } vectors{state_vectors(), owned_dofs};
+      const auto owned = owned_cells(dof_handler);
+      const auto &keys = owned.first;
+      const auto &cells = owned.second;
       std::vector<dealii::types::global_dof_index> dofs(fe->n_dofs_per_cell());
-      Run::parse_collectively(this->get_scene().mpi_communicator(), [&]() {
-        for (std::size_t k = 0; k < cells.size(); ++k)
-          {
-            std::istringstream bytes(records[k]);
-            CheckpointReader   in(bytes, directory.file("cells"));
-            cells[k]->get_dof_indices(dofs);
-            for (Vector *x : vectors)
-              for (const auto i : dofs)
-                {
-                  const double value = in.get<double>();
-                  if (owned_dofs.is_element(i))
-                    (*x)(i) = value;
-                }
-            CellHistory<dim> &h       = *cell_history[cells[k]->active_cell_index()];
-            const std::size_t n_q     = h.stress.size();
-            const std::size_t n_state = h.state.size();
-            in &h;
-            if (h.stress.size() != n_q || h.strain.size() != n_q || h.state.size() != n_state ||
-                h.volume.size() != n_q || h.tangent.size() != n_q || !in.at_end())
-              in.refuse("a cell's state has another size than the scene's (another mesh, element or material)");
-            h.trial_volume = h.volume;
-          }
-      });
-      for (Vector *x : vectors)
+      Run::load_records(directory.file("cells"), keys, this->get_scene().mpi_communicator(),
+                        [&](CheckpointReader &in, const std::size_t k) {
+                          cells[k]->get_dof_indices(dofs);
+                          serialize_cell(in, dofs, vectors, *cell_history[cells[k]->active_cell_index()]);
+                        });
+      for (Vector *x : vectors.x)
         x->compress(dealii::VectorOperation::insert);
       u_ghost = u;
       v_ghost = v;

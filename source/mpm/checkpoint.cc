@@ -24,27 +24,58 @@ namespace hysteron
   {
     namespace
     {
-      /// One material point in a checkpoint: everything the arrays hold of it.
+      /// The format of what this file stores: raise it with every change of a description below.
+      constexpr std::uint32_t format = 2;
+
+      /**
+       * One material point in a checkpoint. Its fields are listed once, in fields():
+       * @p f(record's field, the point arrays' field) for each, which serialize(),
+       * save() (arrays to record) and restore_points() (record to arrays) all use.
+       */
       template <int dim>
       struct PointRecord
       {
-        dealii::types::particle_index   id       = 0;
         unsigned int                    position = 0; ///< in the rank's arrays
         unsigned int                    group    = 0; ///< index of the group template
+        dealii::types::particle_index   id       = 0;
         unsigned int                    body = 0, load = 0, cell = 0;
         double                          mass = 0, volume0 = 0, thickness = 0, load_factor = 0, volume = 0;
         dealii::Point<dim>              x0, x;
         dealii::Tensor<1, dim>          v;
         dealii::SymmetricTensor<2, dim> stress, strain;
         dealii::Tensor<2, dim>          F;
-        std::vector<double>             state;
+        std::vector<double>             state; ///< the material's state variables
+
+        /// @p f(field, array) for every field held in the point arrays (@p f gets the
+        /// array as a function of the arrays: P -> the array).
+        template <class Function>
+        void
+        fields(const Function &f)
+        {
+          f(id, [](auto &P) -> auto & { return P.id; });
+          f(body, [](auto &P) -> auto & { return P.body; });
+          f(load, [](auto &P) -> auto & { return P.load; });
+          f(cell, [](auto &P) -> auto & { return P.cell; });
+          f(mass, [](auto &P) -> auto & { return P.mass; });
+          f(volume0, [](auto &P) -> auto & { return P.volume0; });
+          f(thickness, [](auto &P) -> auto & { return P.thickness; });
+          f(load_factor, [](auto &P) -> auto & { return P.load_factor; });
+          f(volume, [](auto &P) -> auto & { return P.current.volume; });
+          f(x0, [](auto &P) -> auto & { return P.x0; });
+          f(x, [](auto &P) -> auto & { return P.current.x; });
+          f(v, [](auto &P) -> auto & { return P.current.v; });
+          f(stress, [](auto &P) -> auto & { return P.current.stress; });
+          f(strain, [](auto &P) -> auto & { return P.current.strain; });
+          f(F, [](auto &P) -> auto & { return P.current.F; });
+        }
 
         template <class Archive>
         void
         serialize(Archive &ar)
         {
-          ar &id &position &group &body &load &cell &mass &volume0 &thickness &load_factor &volume &x0 &x &v
-            &stress &strain &F &state;
+          ar &position &group;
+          fields([&](auto &value, const auto &) { ar &value; });
+          ar &state;
         }
       };
 
@@ -68,7 +99,7 @@ namespace hysteron
     void
     Solver<dim>::serialize_global(Archive &ar)
     {
-      ar.section("mpm");
+      ar.section("mpm", format);
       ar &n_global_particles &load_count &load_volume &initial_kinetic_energy &n_rebuilds;
       std::uint64_t n_probes = probes.size();
       ar &n_probes;
@@ -80,7 +111,7 @@ namespace hysteron
       if (grid_moves)
         {
           // Where the grid is (a checkpoint of a fixed grid has no such section).
-          ar.section("mpm grid motion");
+          ar.section("mpm grid motion", format);
           Lattice<dim> moved = grid->lattice();
           ar &moved.origin &moved.h &grid_table_time;
           if constexpr (Archive::is_loading)
@@ -100,7 +131,7 @@ namespace hysteron
     void
     Solver<dim>::serialize_rank(Archive &ar)
     {
-      ar.section("mpm rank");
+      ar.section("mpm rank", format);
       ar &internal_work &external_work &boundary_work &max_speed &reactions &n_changed_cells;
     }
 
@@ -130,23 +161,9 @@ namespace hysteron
           for (unsigned int s = group.begin; s < group.end; ++s)
             {
               PointRecord<dim> r;
-              r.id          = P.id[s];
-              r.position    = s;
-              r.group       = key;
-              r.body        = P.body[s];
-              r.load        = P.load[s];
-              r.cell        = P.cell[s];
-              r.mass        = P.mass[s];
-              r.volume0     = P.volume0[s];
-              r.thickness   = P.thickness[s];
-              r.load_factor = P.load_factor[s];
-              r.volume      = P.current.volume[s];
-              r.x0          = P.x0[s];
-              r.x           = P.current.x[s];
-              r.v           = P.current.v[s];
-              r.stress      = P.current.stress[s];
-              r.strain      = P.current.strain[s];
-              r.F           = P.current.F[s];
+              r.position = s;
+              r.group    = key;
+              r.fields([&](auto &value, const auto &array) { value = array(P)[s]; });
               const auto first = P.current.material_state.begin() + group.state_offset +
                                  std::size_t(s - group.begin) * group.n_state;
               r.state.assign(first, first + group.n_state);
@@ -274,22 +291,8 @@ namespace hysteron
       std::size_t offset = 0;
       for (std::size_t s = 0; s < n; ++s)
         {
-          const auto &r        = records[s];
-          P.id[s]              = r.id;
-          P.body[s]            = r.body;
-          P.load[s]            = r.load;
-          P.cell[s]            = r.cell;
-          P.mass[s]            = r.mass;
-          P.volume0[s]         = r.volume0;
-          P.thickness[s]       = r.thickness;
-          P.load_factor[s]     = r.load_factor;
-          P.x0[s]              = r.x0;
-          P.current.x[s]       = r.x;
-          P.current.v[s]       = r.v;
-          P.current.stress[s]  = r.stress;
-          P.current.strain[s]  = r.strain;
-          P.current.F[s]       = r.F;
-          P.current.volume[s]  = r.volume;
+          auto &r = records[s];
+          r.fields([&](const auto &value, const auto &array) { array(P)[s] = value; });
           std::copy(r.state.begin(), r.state.end(), P.current.material_state.begin() + offset);
           offset += r.state.size();
         }

@@ -10,7 +10,7 @@
 
 #include <Epetra_CrsMatrix.h>
 
-#include "run/keyed_records.h"
+#include "run/record_archive.h"
 
 #include <map>
 #include <sstream>
@@ -21,6 +21,9 @@ namespace hysteron
   {
     namespace
     {
+      /// The format of what this file stores: raise it with every change of a description below.
+      constexpr std::uint32_t format = 2;
+
       /// A facet's springs: the converged and trial state and the tangent.
       template <int dim, class Archive, class SpringsType>
       void
@@ -37,13 +40,86 @@ namespace hysteron
     void
     Model<dim>::serialize_global(Archive &ar)
     {
-      ar.section("rbsn");
+      ar.section("rbsn", format);
+      // Not the count of factorizations: it counts this process's work (a resumed run
+      // factorizes its first matrix anew), not state.
       auto increment_state = increments.state();
       ar &force_scale &last_force_level &predictor_level &internal_work &external_work &boundary_work &n_steps
-        &n_newton &n_broken &n_cuts &increment_state &fracture_energy &n_factorizations;
+        &n_newton &n_broken &n_cuts &increment_state &fracture_energy;
       if constexpr (Archive::is_loading)
         increments.restore(increment_state);
       tables.serialize(ar);
+    }
+
+
+
+    template <int dim>
+    template <class Archive>
+    void
+    Model<dim>::serialize_cell(Archive &ar, const unsigned int c)
+    {
+      // The cell's values of the DoF vectors.
+      for (Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
+        for (unsigned int k = 0; k < n_dofs; ++k)
+          ar &x->local_element(n_dofs * c + k);
+
+      // The springs of the facets it owns, each marked with its other cell: the local
+      // order of the facets may differ on another partition.
+      const std::string cell = "cell " + std::to_string(cell_id[c]);
+      std::map<std::uint64_t, unsigned int> facet_of;
+      for (unsigned int e = owned_facet_start[c]; e < owned_facet_start[c + 1]; ++e)
+        facet_of[cell_id[network.facets[e].b]] = e;
+      std::uint64_t n_facets = owned_facet_start[c + 1] - owned_facet_start[c];
+      ar &n_facets;
+      if constexpr (Archive::is_loading)
+        if (n_facets != facet_of.size())
+          ar.refuse(cell + " has another number of facets than in the checkpoint (the same parameters and "
+                    "Random seed give the same network)");
+      for (std::uint64_t f = 0; f < n_facets; ++f)
+        {
+          std::uint64_t other = Archive::is_loading ? 0 : cell_id[network.facets[owned_facet_start[c] + f].b];
+          ar           &other;
+          const auto    found = facet_of.find(other);
+          if (found == facet_of.end())
+            {
+              if constexpr (Archive::is_loading)
+                ar.refuse(cell + " has other neighbours than in the checkpoint");
+            }
+          else
+            {
+              auto             &sp      = springs[found->second];
+              const std::size_t n_state = sp.state.size();
+              serialize_springs<dim>(ar, sp);
+              if constexpr (Archive::is_loading)
+                if (sp.state.size() != n_state || sp.trial_state.size() != n_state)
+                  ar.refuse("the facets' spring states differ from the checkpoint's (another RBSN/Spring law or "
+                            "Analysis)");
+            }
+        }
+    }
+
+
+
+    template <int dim>
+    template <class Archive>
+    void
+    Model<dim>::serialize_tangent(Archive &ar)
+    {
+      // The incrementally assembled tangent: which facets' tangents it holds, and its values.
+      ar.section("rbsn assembled tangent", format);
+      ar &matrix_current &matrix_dt &incremental_updates;
+      if (!matrix_current)
+        return;
+      std::vector<double> values;
+      if constexpr (!Archive::is_loading)
+        values = matrix_values();
+      ar &facet_in_matrix &assembled_tangent &values;
+      if constexpr (Archive::is_loading)
+        {
+          if (facet_in_matrix.size() != springs.size() || assembled_tangent.size() != springs.size())
+            ar.refuse("the checkpoint's assembled tangent does not match the network");
+          set_matrix_values(values);
+        }
     }
 
 
@@ -54,39 +130,14 @@ namespace hysteron
     {
       auto &self = const_cast<Model<dim> &>(*this); // serialize() only reads when saving
       self.serialize_global(global);
-
-      // The incrementally assembled tangent: which facets' tangents it holds, and its values.
-      rank.section("rbsn assembled tangent");
-      rank.put(matrix_current);
-      rank.put(matrix_dt);
-      rank.put(incremental_updates);
-      if (matrix_current)
-        {
-          rank.put(facet_in_matrix);
-          rank.put(assembled_tangent);
-          rank.put(matrix_values());
-        }
-
+      self.serialize_tangent(rank);
       // A replicated network (every rank holds all of it) is written by rank 0.
-      const MPI_Comm comm = scene.mpi_communicator();
-      std::vector<std::pair<std::uint64_t, std::string>> records;
+      const MPI_Comm             comm = scene.mpi_communicator();
+      std::vector<std::uint64_t> keys;
       if (distributed() || dealii::Utilities::MPI::this_mpi_process(comm) == 0)
-        for (unsigned int c = 0; c < n_owned_cells; ++c)
-          {
-            std::ostringstream bytes;
-            CheckpointWriter   out(bytes);
-            for (const Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
-              for (unsigned int k = 0; k < n_dofs; ++k)
-                out.put(x->local_element(n_dofs * c + k));
-            out.put<std::uint64_t>(owned_facet_start[c + 1] - owned_facet_start[c]);
-            for (unsigned int e = owned_facet_start[c]; e < owned_facet_start[c + 1]; ++e)
-              {
-                out.put<std::uint64_t>(cell_id[network.facets[e].b]);
-                serialize_springs<dim>(out, self.springs[e]);
-              }
-            records.emplace_back(cell_id[c], bytes.str());
-          }
-      Run::write_records(directory.file("cells"), n_cells, records, comm);
+        keys.assign(cell_id.begin(), cell_id.begin() + n_owned_cells);
+      Run::save_records(directory.file("cells"), n_cells, keys, comm,
+                        [&](CheckpointWriter &out, const std::size_t c) { self.serialize_cell(out, c); });
     }
 
 
@@ -98,64 +149,17 @@ namespace hysteron
                      const CheckpointDirectory     &directory)
     {
       serialize_global(global);
-
-      std::vector<std::uint64_t> keys(cell_id.begin(), cell_id.begin() + n_owned_cells);
-      const auto records = Run::read_records(directory.file("cells"), keys, scene.mpi_communicator());
-      const std::string file = directory.file("cells");
-      Run::parse_collectively(scene.mpi_communicator(), [&]() {
-        for (unsigned int c = 0; c < n_owned_cells; ++c)
-          {
-            std::istringstream bytes(records[c]);
-            CheckpointReader   in(bytes, file);
-            for (Vector *x : {&u, &u_trial, &v, &a, &f_int, &f_ext, &f_ext_old, &inertia, &reaction_old})
-              for (unsigned int k = 0; k < n_dofs; ++k)
-                in.get(x->local_element(n_dofs * c + k));
-            // The facets by their other cell: the local order may differ on another partition.
-            std::map<std::uint64_t, unsigned int> facet_of;
-            for (unsigned int e = owned_facet_start[c]; e < owned_facet_start[c + 1]; ++e)
-              facet_of[cell_id[network.facets[e].b]] = e;
-            const auto n_facets = in.get<std::uint64_t>();
-            if (n_facets != facet_of.size())
-              in.refuse("cell " + std::to_string(cell_id[c]) + " has another number of facets than in the "
-                        "checkpoint (the same parameters and Random seed give the same network)");
-            for (std::uint64_t f = 0; f < n_facets; ++f)
-              {
-                const auto found = facet_of.find(in.get<std::uint64_t>());
-                if (found == facet_of.end())
-                  in.refuse("cell " + std::to_string(cell_id[c]) + " has other neighbours than in the checkpoint");
-                auto             &sp      = springs[found->second];
-                const std::size_t n_state = sp.state.size();
-                serialize_springs<dim>(in, sp);
-                if (sp.state.size() != n_state || sp.trial_state.size() != n_state)
-                  in.refuse("the facets' spring states differ from the checkpoint's (another RBSN/Spring law or "
-                            "Analysis)");
-              }
-            if (!in.at_end())
-              in.refuse("a cell's record is longer than this network's cell (another network)");
-          }
-      });
+      const std::vector<std::uint64_t> keys(cell_id.begin(), cell_id.begin() + n_owned_cells);
+      Run::load_records(directory.file("cells"), keys, scene.mpi_communicator(),
+                        [&](CheckpointReader &in, const std::size_t c) { serialize_cell(in, c); });
       for (Vector *x : {&u, &u_trial, &v, &a})
         x->update_ghost_values();
       update_fragments(); // from the broken facets
 
-      matrix_current = false; // on another partition the first step assembles anew
-      if (!directory.same_ranks())
-        return;
-      CheckpointReader &in = rank_parts[0];
-      in.section("rbsn assembled tangent");
-      in.get(matrix_current);
-      in.get(matrix_dt);
-      in.get(incremental_updates);
-      if (matrix_current)
-        {
-          in.get(facet_in_matrix);
-          in.get(assembled_tangent);
-          std::vector<double> values;
-          in.get(values);
-          if (facet_in_matrix.size() != springs.size() || assembled_tangent.size() != springs.size())
-            throw RuntimeError("the checkpoint's assembled tangent does not match the network");
-          set_matrix_values(values);
-        }
+      // The tangent of as many ranks only: on another partition the first step assembles anew.
+      matrix_current = false;
+      if (directory.same_ranks())
+        serialize_tangent(rank_parts[0]);
     }
 
 

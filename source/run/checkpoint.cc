@@ -430,7 +430,7 @@ namespace hysteron
     void
     write_resume_header(CheckpointWriter &out, const std::string &method, const std::string &parameters)
     {
-      out.section("driver");
+      out.section("driver", 2);
       out.put(method);
       out.put(resumable_parameters(parameters));
     }
@@ -465,7 +465,7 @@ namespace hysteron
         std::string      written_by, written_parameters;
         try
           {
-            reader.section("driver");
+            reader.section("driver", 2);
             reader.get(written_by);
             reader.get(written_parameters);
           }

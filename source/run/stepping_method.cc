@@ -158,8 +158,8 @@ namespace hysteron
                          global.put(loop->fields.next_time());
                          global.put(field_writer->records());
                          global.put(sizes);
-                         global.section(label());
-                         rank.section(label());
+                         global.section(label(), 2); // the driver's format (as "driver")
+                         rank.section(label(), 2);
                          save(global, rank, directory);
                        });
       loop->last_checkpoint = loop->wall.wall_time();
@@ -228,7 +228,7 @@ namespace hysteron
           resume       = std::make_unique<CheckpointParts>(this->resume_from(), comm);
           auto &reader = resume->global();
           std::string method, parameters;
-          reader.section("driver");
+          reader.section("driver", 2);
           reader.get(method);
           reader.get(parameters);
           reader.get(t);
@@ -252,9 +252,9 @@ namespace hysteron
       if (resume)
         {
           field_writer->restore(field_records);
-          resume->global().section(name);
+          resume->global().section(name, 2);
           for (auto &part : resume->ranks())
-            part.section(name);
+            part.section(name, 2);
           load(resume->global(), resume->ranks(), this->resume_from());
           if (!resume->global().at_end())
             resume->global().refuse("the checkpoint holds more than this scene reads");

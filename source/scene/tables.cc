@@ -290,7 +290,7 @@ namespace hysteron
     void
     Tables<dim>::serialize(Archive &ar)
     {
-      ar.section("tables");
+      ar.section("tables", 2); // raise with every change of what it stores
       auto energy = energy_log.state();
       ar &has_written &last_time &energy;
       if constexpr (Archive::is_loading)

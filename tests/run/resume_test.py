@@ -15,6 +15,10 @@ uninterrupted run.
 3. `hysteron --resume` continues it: exit status 0, and every CSV equals the reference's
    (same rows, values within 1e-12 of each column's largest magnitude), the PVD lists the
    same times, and the manifest says "finished".
+4. On as many ranks, every checkpoint that both runs wrote after the resume is the same,
+   file for file and byte for byte: each method's state is described once for save and
+   load, so a field it saves but does not restore would start the resumed run from
+   another value and show here even where no table reads it.
 On N ranks, all three runs use N ranks; with --resume-np M the resumed run has M ranks
 (a job moved to another allocation), and its tables must equal the reference's within the
 tolerance that the method's 1-rank and 2-rank runs meet (--tolerance, of each column's
@@ -76,6 +80,33 @@ def pvd_times(directory):
                 with open(os.path.join(root, name)) as f:
                     times[name] = re.findall(r'timestep="([^"]*)"', f.read())
     return times
+
+
+def checkpoints(directory):
+    """The checkpoint directories under @directory by their path relative to it."""
+    found = {}
+    for root, dirs, _ in os.walk(directory):
+        for d in dirs:
+            if d.startswith("checkpoint-"):
+                path = os.path.join(root, d)
+                found[os.path.relpath(path, directory)] = path
+    return found
+
+
+def differing_files(a, b):
+    """Files of checkpoint directory a that b lacks or holds with other bytes."""
+    different = []
+    for root, _, files in os.walk(a):
+        for name in files:
+            pa = os.path.join(root, name)
+            pb = os.path.join(b, os.path.relpath(pa, a))
+            if not os.path.exists(pb):
+                different.append(os.path.relpath(pa, a) + " (missing)")
+            else:
+                with open(pa, "rb") as fa, open(pb, "rb") as fb:
+                    if fa.read() != fb.read():
+                        different.append(os.path.relpath(pa, a))
+    return different
 
 
 def main():
@@ -187,6 +218,20 @@ def main():
                 failures.append(f"{path}: status {manifest.get('status')!r}, resumed "
                                 f"{manifest.get('resumed')!r}")
         print(f"compared {len(expected)} tables")
+        if resume_np == args.np:
+            # The checkpoints written after the resume (the stopped run's from before it
+            # were kept or deleted as the reference's were).
+            expected, got = checkpoints(reference), checkpoints(stopped)
+            steps = lambda path: int(path.rsplit("-", 1)[1])
+            after = [c for c in sorted(expected) if c in got and steps(c) > at]
+            if not after:
+                failures.append(f"no checkpoint after step {at} in both runs: {sorted(expected)} vs {sorted(got)}")
+            for c in after:
+                different = differing_files(expected[c], got[c])
+                if different:
+                    failures.append(f"{c}: the resumed run's checkpoint differs from the uninterrupted run's in "
+                                    + ", ".join(different) + " (a state field saved but not restored?)")
+            print(f"compared {len(after)} checkpoints byte for byte")
 
     if failures:
         print("FAILED:\n  " + "\n  ".join(failures))

@@ -27,12 +27,21 @@ namespace hysteron
     {};
   } // namespace internal
 
+  /// How a section starts in the file: "section:<name> v<version>".
+  inline std::string
+  section_tag(const std::string &name, const std::uint32_t version)
+  {
+    return "section:" + name + " v" + std::to_string(version);
+  }
+
+
+
   /**
    * The binary archive a checkpoint is written with. As in Boost and deal.II,
    * a state describes itself once, in
    * @code
    *   template <class Archive> void serialize(Archive &ar)
-   *   { ar.section("my state"); ar & a & b & c; }
+   *   { ar.section("my state", 1); ar & a & b & c; }
    * @endcode
    * and the same function writes it (with a CheckpointWriter) and reads it
    * back (with a CheckpointReader), so that a field saved but not restored
@@ -42,7 +51,10 @@ namespace hysteron
    * SymmetricTensor; strings, vectors, arrays, pairs, maps of them; classes
    * with a serialize() member), so that a resumed run continues from exactly
    * the state of the interrupted one. Named sections make the reader refuse a
-   * checkpoint of another version or method instead of misreading it.
+   * checkpoint of another method instead of misreading it, and each section
+   * carries the version of its format: a serialize() that changes what it
+   * stores raises its version, so that an older checkpoint is refused with
+   * both versions named rather than read wrongly.
    */
   class CheckpointWriter
   {
@@ -53,11 +65,11 @@ namespace hysteron
       : out(out)
     {}
 
-    /// Start a section: the reader must ask for the same name here.
+    /// Start a section in format @p version: the reader must ask for the same name and version here.
     void
-    section(const std::string &name)
+    section(const std::string &name, const std::uint32_t version)
     {
-      put(std::string("section:") + name);
+      put(section_tag(name, version));
     }
 
     template <typename T>
@@ -148,9 +160,9 @@ namespace hysteron
       , filename(filename)
     {}
 
-    /// Check that the next section is @p name.
+    /// Check that the next section is @p name in format @p version.
     void
-    section(const std::string &name);
+    section(const std::string &name, std::uint32_t version);
 
     template <typename T>
     CheckpointReader &

@@ -144,6 +144,16 @@ namespace hysteron
       void
       serialize_global(Archive &ar);
 
+      /// Owned cell @p c in a checkpoint: its DoF values and the springs of its facets.
+      template <class Archive>
+      void
+      serialize_cell(Archive &ar, unsigned int c);
+
+      /// This rank's incrementally assembled tangent (read back on as many ranks only).
+      template <class Archive>
+      void
+      serialize_tangent(Archive &ar);
+
       using SpringVector = typename SpringLaw<dim>::Vector;
       using SpringMatrix = typename SpringLaw<dim>::Matrix;
       using dof_index    = dealii::types::global_dof_index;
