@@ -611,7 +611,7 @@ namespace hysteron
             // The same DoF's history under either condition (prescribed_increment() reads
             // only the set's boundary), translations and rotations alike.
             const unsigned int k = dof % n_dofs;
-            static const char *axes[3] = {"x", "y", "z"};
+            static const char *const axes[3] = {"x", "y", "z"};
             const std::string  name = k < dim ? std::string(axes[k]) :
                                       dim == 2 ? std::string("rotation") :
                                                  "rotation about " + std::string(axes[k - dim]);
@@ -1034,7 +1034,7 @@ namespace hysteron
     Solver<dim>::parse_parameters(dealii::ParameterHandler &prm)
     {
       // The network's tables have cell and facet columns, not continuum points.
-      require(PointData::additional_columns<dim>().empty(),
+      require(this->get_scene().output_control().additional_columns.empty(),
               "Output/Additional columns",
               "the rbsn method's probe tables hold cell and facet values; additional point "
               "columns apply to the mpm and fem methods");

@@ -563,6 +563,7 @@ namespace hysteron
       const unsigned int                                                         keep,
       const std::map<std::string, std::uint64_t>                                &tables,
       const std::vector<FileDigest>                                             &inputs,
+      Output::RunRecord                                                         &record,
       const std::function<void(CheckpointWriter &, CheckpointWriter &, const CheckpointDirectory &)> &write)
     {
       const unsigned int rank    = dealii::Utilities::MPI::this_mpi_process(comm);
@@ -684,7 +685,6 @@ namespace hysteron
             try
               {
                 // The manifest lists the checkpoint (its write may fail too).
-                auto &record = Output::RunRecord::get();
                 record.add_directory(final_dir.string());
                 // Keep the newest `keep`.
                 std::vector<std::pair<long, fs::path>> existing;
