@@ -88,12 +88,8 @@ namespace hysteron
      * Collective.
      */
     CheckpointFile
-    find_resumable_checkpoint(const std::string             &directory,
-                              const std::string             &method,
-                              const std::string             &parameters,
-                              const std::vector<FileDigest> &inputs,
-                              MPI_Comm                       comm,
-                              std::ostream                  &notes);
+    find_resumable_checkpoint(const std::string &directory, const std::string &method, const std::string &parameters,
+                              const std::vector<FileDigest> &inputs, MPI_Comm comm, std::ostream &notes);
 
     /**
      * What the driver and the method read on resume: global.bin (read on rank 0,
@@ -141,7 +137,8 @@ namespace hysteron
      * @p directory and length, on rank 0) and of @p inputs go to info.txt and the
      * checkpoint is published, listed in the run's @p record. Keeps the newest
      * @p keep checkpoints. Collective; throws RuntimeError on every rank if any
-     * rank failed.
+     * rank failed. (checkpoint_info.cc: the names, info.txt and digests;
+     * checkpoint_write.cc: this; checkpoint_resume.cc: finding and reading one.)
      */
     void
     write_checkpoint(
