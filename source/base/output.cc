@@ -70,9 +70,10 @@ namespace hysteron
         }
     }
 
-    AtomicFile::AtomicFile(const std::string &filename)
+    AtomicFile::AtomicFile(const std::string &filename, RunRecord *const record)
       : final_name(filename)
       , temporary_name(filename + ".tmp")
+      , record(record)
       , out(temporary_name)
     {
       if (!out)
@@ -112,7 +113,8 @@ namespace hysteron
                              (error != 0 ? std::strerror(error) : "an input/output error"));
         }
       committed = true;
-      RunRecord::get().add_file(final_name);
+      if (record != nullptr)
+        record->add_file(final_name);
     }
 
     void
@@ -134,9 +136,9 @@ namespace hysteron
     }
 
     void
-    write_file(const std::string &filename, const std::string &content)
+    write_file(const std::string &filename, const std::string &content, RunRecord *const record)
     {
-      AtomicFile file(filename);
+      AtomicFile file(filename, record);
       file.stream() << content;
       file.commit();
     }
@@ -185,9 +187,11 @@ namespace hysteron
       }
     } // namespace
 
-    CsvWriter::CsvWriter(const std::string &filename, const std::vector<std::string> &columns)
+    CsvWriter::CsvWriter(const std::string              &filename,
+                         const std::vector<std::string> &columns,
+                         RunRecord *const                record)
       : columns(columns)
-      , file(filename)
+      , file(filename, record)
     {
       file.stream() << header_line(columns);
     }
@@ -199,12 +203,14 @@ namespace hysteron
       file.stream() << format_row(values);
     }
 
-    TimeTable::TimeTable(const std::string &filename, const std::vector<std::string> &columns)
+    TimeTable::TimeTable(const std::string              &filename,
+                         const std::vector<std::string> &columns,
+                         RunRecord                      &record)
       : name(filename)
+      , record(record)
       , n_columns_(columns.size())
       , last_flush(wall_seconds())
     {
-      auto        &record  = RunRecord::get();
       std::int64_t keep    = record.resume_size(record.relative(filename));
       const bool   resumed = keep >= 0;
       if (!resumed)
@@ -213,7 +219,7 @@ namespace hysteron
           // the table never exists under its name without it (a run killed before its first
           // flush leaves a table with no rows, not an empty file).
           const std::string header = header_line(columns);
-          write_file(filename, header);
+          write_file(filename, header, &record);
           keep = header.size();
         }
       // The rows follow the first keep bytes: the header, or on resume the rows up to the
@@ -239,7 +245,7 @@ namespace hysteron
 
     TimeTable::~TimeTable()
     {
-      RunRecord::get().unregister_table(this);
+      record.unregister_table(this);
       try
         {
           flush();
@@ -327,10 +333,12 @@ namespace hysteron
 
     FieldWriter::FieldWriter(const std::string &directory,
                              const std::string &base_name,
-                             MPI_Comm           comm)
+                             MPI_Comm           comm,
+                             RunRecord *const   record)
       : directory(directory)
       , base_name(base_name)
       , comm(comm)
+      , record(record)
     {}
 
     template <int dim, int spacedim>
@@ -366,21 +374,24 @@ namespace hysteron
 
       const std::string piece_name =
         n_ranks == 1 ? stem + ".vtu" : stem + "." + dealii::Utilities::int_to_string(rank, 4) + ".vtu";
-      const std::string record = n_ranks == 1 ? piece_name : stem + ".pvtu";
-      collectively(comm, true, [&]() { AtomicFile(directory + "/" + piece_name).write(piece); });
+      const std::string record_name = n_ranks == 1 ? piece_name : stem + ".pvtu";
+      collectively(comm, true, [&]() { AtomicFile(directory + "/" + piece_name, record).write(piece); });
 
       // Every piece exists before the record that names it (collectively() waits for all).
-      times_and_names.emplace_back(time, record);
+      times_and_names.emplace_back(time, record_name);
       collectively(comm, rank == 0, [&]() {
         if (n_ranks > 1)
           {
             std::vector<std::string> pieces;
             for (unsigned int r = 0; r < n_ranks; ++r)
               pieces.push_back(stem + "." + dealii::Utilities::int_to_string(r, 4) + ".vtu");
-            AtomicFile(directory + "/" + record).write([&](std::ostream &out) { record_writer(out, pieces); });
+            AtomicFile(directory + "/" + record_name, record).write([&](std::ostream &out) {
+              record_writer(out, pieces);
+            });
             // The pieces of the other ranks belong to this run too.
-            for (unsigned int r = 1; r < n_ranks; ++r)
-              RunRecord::get().add_file(directory + "/" + pieces[r]);
+            if (record != nullptr)
+              for (unsigned int r = 1; r < n_ranks; ++r)
+                record->add_file(directory + "/" + pieces[r]);
           }
         write_pvd();
       });
@@ -392,11 +403,11 @@ namespace hysteron
     {
       if (!times_and_names.empty() && times_and_names.back().first == time)
         return;
-      const std::string record = base_name + "-" + dealii::Utilities::int_to_string(counter, 5) + ".vtu";
-      times_and_names.emplace_back(time, record);
+      const std::string file = base_name + "-" + dealii::Utilities::int_to_string(counter, 5) + ".vtu";
+      times_and_names.emplace_back(time, file);
       ++counter;
       collectively(comm, dealii::Utilities::MPI::this_mpi_process(comm) == 0, [&]() {
-        AtomicFile(directory + "/" + record).write(writer);
+        AtomicFile(directory + "/" + file, record).write(writer);
         write_pvd();
       });
     }
@@ -404,7 +415,7 @@ namespace hysteron
     void
     FieldWriter::write_pvd() const
     {
-      AtomicFile(directory + "/" + base_name + ".pvd").write([&](std::ostream &out) {
+      AtomicFile(directory + "/" + base_name + ".pvd", record).write([&](std::ostream &out) {
         dealii::DataOutBase::write_pvd_record(out, times_and_names);
       });
     }

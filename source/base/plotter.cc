@@ -220,7 +220,8 @@ namespace hysteron
           return program + " failed on " + command.subject + " (" + failure + ")" + printed +
                  no_png;
         }
-      Output::RunRecord::get().add_file(png.string());
+      if (command.record != nullptr)
+        command.record->add_file(png.string());
       return messages.empty() ? "" : program + " on " + command.subject + printed;
     }
 
@@ -246,7 +247,10 @@ namespace hysteron
 
 
     std::string
-    run_gnuplot(const std::string &script_file, const std::string &png_file, const double timeout)
+    run_gnuplot(const std::string       &script_file,
+                const std::string       &png_file,
+                const double             timeout,
+                Output::RunRecord *const record)
     {
       const fs::path script(script_file);
       if (!gnuplot_available())
@@ -260,6 +264,7 @@ namespace hysteron
       command.png_file  = png_file;
       command.subject   = script_file;
       command.timeout   = timeout;
+      command.record    = record;
       return run_plotter(command);
     }
   } // namespace Plot

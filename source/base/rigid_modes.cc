@@ -70,8 +70,8 @@ namespace hysteron
                           gram.begin() + (part + 1) * n_modes * n_modes);
     const double        scale = *std::max_element(g.begin(), g.end());
     const double        tiny  = 1e-10 * std::max(scale, 1e-300);
-    static const char  *names[] = {"translation in x", "translation in y", "translation in z",
-                                   "rotation about x", "rotation about y", "rotation about z"};
+    static const char *const names[] = {"translation in x", "translation in y", "translation in z",
+                                        "rotation about x", "rotation about y", "rotation about z"};
     std::vector<std::string> out;
     for (unsigned int k = 0; k < n_modes; ++k)
       if (!(g[k * n_modes + k] > tiny))

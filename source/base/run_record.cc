@@ -8,13 +8,6 @@ namespace hysteron
 {
   namespace Output
   {
-    RunRecord &
-    RunRecord::get()
-    {
-      static RunRecord record;
-      return record;
-    }
-
     void
     RunRecord::begin(const std::string &dir, const bool is_root, std::function<void()> files_changed)
     {

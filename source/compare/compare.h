@@ -19,7 +19,9 @@ namespace hysteron
    * the summaries, plots.cc the gnuplot scripts, plotter.cc runs the plotter,
    * compare_method.cc is the registered method `compare`.
    *
-   * None of these functions is collective: call them on one MPI rank.
+   * None of these functions is collective: call them on one MPI rank. The
+   * writers take the record of the run whose files they write (null: the
+   * comparison of two directories on its own).
    */
   namespace Compare
   {
@@ -152,7 +154,8 @@ namespace hysteron
     write_side_by_side(const TableComparison &comparison,
                        const std::string     &label_a,
                        const std::string     &label_b,
-                       const std::string     &filename);
+                       const std::string     &filename,
+                       Output::RunRecord     *record = nullptr);
 
     /**
      * Write a gnuplot script that draws @p columns of the side-by-side table
@@ -170,7 +173,8 @@ namespace hysteron
                          const std::string              &label_b,
                          const std::string              &data_file,
                          const std::string              &png_file,
-                         const std::string              &script_file);
+                         const std::string              &script_file,
+                         Output::RunRecord              *record = nullptr);
 
     // The plotter (base/plotter.h), which the methods' set histories draw with too.
     using Plot::gnuplot_available;
@@ -217,15 +221,22 @@ namespace hysteron
 
       /// Called with a line of progress per plot (none if empty).
       std::function<void(const std::string &)> progress;
+
+      /// The run whose files the comparison writes (null: none).
+      Output::RunRecord *record = nullptr;
     };
 
     /// Write summary.csv: one row per (table, column), sorted by table then column.
     void
-    write_summary_csv(const ComparisonReport &report, const std::string &filename);
+    write_summary_csv(const ComparisonReport &report,
+                      const std::string      &filename,
+                      Output::RunRecord      *record = nullptr);
 
     /// Write summary.md: the same as a Markdown table, relative differences in %.
     void
-    write_summary_markdown(const ComparisonReport &report, const std::string &filename);
+    write_summary_markdown(const ComparisonReport &report,
+                           const std::string      &filename,
+                           Output::RunRecord      *record = nullptr);
 
     /**
      * Compare the tables @p files (plain file names such as "probe_0.csv";

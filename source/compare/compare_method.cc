@@ -61,8 +61,12 @@ namespace hysteron
       void
       setup() override
       {
+        // The methods write into this run's directory: its files, its record.
         for (auto &method : methods)
-          method->setup();
+          {
+            method->set_run_context(this->inputs(), this->resume_from(), this->run_record());
+            method->setup();
+          }
       }
 
       std::string
@@ -109,6 +113,7 @@ namespace hysteron
         options.plot_columns = plot_columns;
         options.plots        = false;
         options.plot_timeout = plot_timeout;
+        options.record       = &this->run_record();
         options.progress     = [&scene](const std::string &line) {
           scene.console() << line << std::endl;
         };

@@ -112,7 +112,8 @@ namespace hysteron
                          const std::string              &label_b,
                          const std::string              &data_file,
                          const std::string              &png_file,
-                         const std::string              &script_file)
+                         const std::string              &script_file,
+                         Output::RunRecord              *record)
     {
       check_labels(label_a, label_b);
       const std::size_t  n_panels = std::max<std::size_t>(columns.size(), 1);
@@ -121,7 +122,7 @@ namespace hysteron
       const std::string  style  = comparison.time.size() > 1 ? "lines" : "points pt 7";
       const std::string  temporary = png_file + ".tmp";
 
-      Output::AtomicFile file(script_file);
+      Output::AtomicFile file(script_file, record);
       auto              &out = file.stream();
       out << "# " << comparison.name << ": " << label_b << " against " << label_a
           << ", written by hysteron (doc/compare.md).\n"
@@ -209,8 +210,9 @@ namespace hysteron
                                report.label_b,
                                stem + ".csv",
                                png,
-                               script);
-          const std::string warning = run_gnuplot(script, png, options.plot_timeout);
+                               script,
+                               options.record);
+          const std::string warning = run_gnuplot(script, png, options.plot_timeout, options.record);
           if (!warning.empty())
             report.warnings.push_back(warning);
           if (options.progress)

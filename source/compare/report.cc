@@ -151,7 +151,8 @@ namespace hysteron
     write_side_by_side(const TableComparison &comparison,
                        const std::string     &label_a,
                        const std::string     &label_b,
-                       const std::string     &filename)
+                       const std::string     &filename,
+                       Output::RunRecord     *record)
     {
       check_labels(label_a, label_b);
       std::vector<std::string> header{"time"};
@@ -159,7 +160,7 @@ namespace hysteron
         for (const auto &suffix : {label_a, label_b, std::string("diff")})
           header.push_back(c + "_" + suffix);
 
-      Output::CsvWriter   csv(filename, header);
+      Output::CsvWriter   csv(filename, header, record);
       std::vector<double> row(header.size());
       for (std::size_t r = 0; r < comparison.time.size(); ++r)
         {
@@ -178,9 +179,9 @@ namespace hysteron
 
 
     void
-    write_summary_csv(const ComparisonReport &report, const std::string &filename)
+    write_summary_csv(const ComparisonReport &report, const std::string &filename, Output::RunRecord *record)
     {
-      Output::AtomicFile file(filename);
+      Output::AtomicFile file(filename, record);
       auto              &out = file.stream();
       out << "table,column,status,rows,time_begin,time_end,scale,max_abs_difference,"
              "max_relative_difference,l2_relative_difference\n";
@@ -205,11 +206,11 @@ namespace hysteron
 
 
     void
-    write_summary_markdown(const ComparisonReport &report, const std::string &filename)
+    write_summary_markdown(const ComparisonReport &report, const std::string &filename, Output::RunRecord *record)
     {
       const std::string A = report.label_a, B = report.label_b;
 
-      Output::AtomicFile file(filename);
+      Output::AtomicFile file(filename, record);
       auto              &out = file.stream();
       out << "# " << B << " against " << A << "\n\n"
           << "A = " << A << " (`" << report.directory_a << "`), B = " << B << " (`"
@@ -363,10 +364,10 @@ namespace hysteron
         if (!t.time.empty())
           {
             const std::string data = fs::path(t.name).stem().string() + ".csv";
-            write_side_by_side(t, label_a, label_b, (fs::path(out_dir) / data).string());
+            write_side_by_side(t, label_a, label_b, (fs::path(out_dir) / data).string(), options.record);
           }
-      write_summary_csv(report, (fs::path(out_dir) / "summary.csv").string());
-      write_summary_markdown(report, (fs::path(out_dir) / "summary.md").string());
+      write_summary_csv(report, (fs::path(out_dir) / "summary.csv").string(), options.record);
+      write_summary_markdown(report, (fs::path(out_dir) / "summary.md").string(), options.record);
       if (options.plots)
         write_plots(report, options);
       return report;

@@ -87,10 +87,14 @@ namespace hysteron
     Solver<dim>::open_tables()
     {
       const Scene<dim> &scene = this->get_scene();
-      tables.open(scene, this->output_directory(), PointData::columns<dim>(state_names));
+      tables.open(scene,
+                  this->output_directory(),
+                  PointData::columns<dim>(state_names, scene.output_control().additional_columns),
+                  this->run_record());
       if (scene.is_root() && analysis != Analysis::explicit_dynamics)
         newton_table = std::make_unique<Output::TimeTable>(this->output_file("newton.csv"),
-                                                           newton_columns());
+                                                           newton_columns(),
+                                                           this->run_record());
     }
 
 
@@ -161,7 +165,8 @@ namespace hysteron
                                      make_array_view(h.state.data() + q * h.n_state,
                                                      h.state.data() + (q + 1) * h.n_state),
                                      state_names.size(),
-                                     row);
+                                     row,
+                                     scene.output_control().additional_columns);
             }
           if (probes[i].has_cell)
             {
@@ -207,7 +212,8 @@ namespace hysteron
                       double      *avg  = averages.data() + r * (1 + n_values);
                       const double mass = rho * h.weight[q];
                       PointData::values<dim>(h.point[q] + uq[q], uq[q], vq[q], h.stress[q], h.strain[q],
-                                             h.material, state, state_names.size(), values.data());
+                                             h.material, state, state_names.size(), values.data(),
+                                             scene.output_control().additional_columns);
                       avg[0] += mass;
                       for (unsigned int c = 0; c < n_values; ++c)
                         avg[1 + c] += mass * values[c];
@@ -236,7 +242,8 @@ namespace hysteron
         strain(n_sym, dealii::Vector<float>(n_cells)),
         state(state_names.size(), dealii::Vector<float>(n_cells));
       dealii::Vector<float> von_mises(n_cells), body(n_cells), subdomain(n_cells);
-      std::vector<double>   values(PointData::columns<dim>(state_names).size());
+      const auto           &additional = this->get_scene().output_control().additional_columns;
+      std::vector<double>   values(PointData::columns<dim>(state_names, additional).size());
       for (const auto &cell : triangulation->active_cell_iterators())
         if (cell->is_locally_owned())
           {
@@ -252,7 +259,7 @@ namespace hysteron
                                        h.strain[q], h.material,
                                        make_array_view(h.state.data() + q * h.n_state,
                                                        h.state.data() + (q + 1) * h.n_state),
-                                       state_names.size(), values.data());
+                                       state_names.size(), values.data(), additional);
                 // values: x, u, v (dim each), stress (n_sym), von Mises, strain, state
                 for (unsigned int k = 0; k < n_sym; ++k)
                   {
@@ -274,7 +281,7 @@ namespace hysteron
                                DataOut<dim>::type_dof_data, vector);
       data_out.add_data_vector(v_ghost, std::vector<std::string>(dim, "velocity"),
                                DataOut<dim>::type_dof_data, vector);
-      const auto columns = PointData::columns<dim>(state_names);
+      const auto columns = PointData::columns<dim>(state_names, additional);
       for (unsigned int k = 0; k < n_sym; ++k)
         {
           data_out.add_data_vector(stress[k], columns[3 * dim + k], DataOut<dim>::type_cell_data);
@@ -297,7 +304,8 @@ namespace hysteron
     {
       using namespace dealii;
       const Scene<dim>  &scene   = this->get_scene();
-      const auto         columns = PointData::columns<dim>(state_names);
+      const auto        &additional = scene.output_control().additional_columns;
+      const auto         columns    = PointData::columns<dim>(state_names, additional);
       const unsigned int width   = columns.size() + 1 + dim;
       const unsigned int n_q     = quadrature->size();
       const FEValuesExtractors::Vector displacement(0);
@@ -323,7 +331,7 @@ namespace hysteron
                                        h.material,
                                        make_array_view(h.state.data() + q * h.n_state,
                                                        h.state.data() + (q + 1) * h.n_state),
-                                       state_names.size(), rows.data() + start);
+                                       state_names.size(), rows.data() + start, additional);
               }
           }
       const auto all = Utilities::MPI::gather(scene.mpi_communicator(), rows, 0);
@@ -336,7 +344,7 @@ namespace hysteron
       std::sort(table.begin(), table.end());
       std::vector<std::string> header{"body"};
       header.insert(header.end(), columns.begin(), columns.end());
-      Output::CsvWriter out(this->output_file("quadrature_points.csv"), header);
+      Output::CsvWriter out(this->output_file("quadrature_points.csv"), header, &this->run_record());
       for (const auto &row : table)
         out.add_row(std::vector<double>(row.begin() + dim, row.end()));
       out.commit();

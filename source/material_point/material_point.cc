@@ -214,7 +214,9 @@ namespace hysteron
 
       std::unique_ptr<Output::TimeTable> csv;
       if (scene.is_root())
-        csv = std::make_unique<Output::TimeTable>(scene.output_file("history.csv"), column_names());
+        csv = std::make_unique<Output::TimeTable>(scene.output_file("history.csv"),
+                                                  column_names(),
+                                                  this->run_record());
 
       // One CSV row: all six components, the out-of-plane ones from the model in 2D.
       const auto write_row = [&](const double t) {

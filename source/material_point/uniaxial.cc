@@ -110,7 +110,9 @@ namespace hysteron
 
       std::unique_ptr<Output::TimeTable> csv;
       if (scene.is_root())
-        csv = std::make_unique<Output::TimeTable>(scene.output_file("history.csv"), column_names());
+        csv = std::make_unique<Output::TimeTable>(scene.output_file("history.csv"),
+                                                  column_names(),
+                                                  this->run_record());
 
       double state[State::max_n_state_variables];
       law.initialize_state(state);

@@ -502,7 +502,8 @@ namespace hysteron
             columns.push_back(std::string("lower_") + component_suffix[d]);
           for (unsigned int d = 0; d < dim; ++d)
             columns.push_back(std::string("h_") + component_suffix[d]);
-          grid_table = std::make_unique<Output::TimeTable>(this->output_file("grid.csv"), columns);
+          grid_table =
+            std::make_unique<Output::TimeTable>(this->output_file("grid.csv"), columns, this->run_record());
         }
     }
 

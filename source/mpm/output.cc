@@ -15,7 +15,10 @@ namespace hysteron
     void
     Solver<dim>::open_tables()
     {
-      tables.open(this->get_scene(), this->output_directory(), PointData::columns<dim>(state_names));
+      tables.open(this->get_scene(),
+                  this->output_directory(),
+                  PointData::columns<dim>(state_names, this->get_scene().output_control().additional_columns),
+                  this->run_record());
     }
 
 
@@ -24,7 +27,7 @@ namespace hysteron
     std::vector<std::string>
     Solver<dim>::point_columns() const
     {
-      return PointData::columns<dim>(state_names);
+      return PointData::columns<dim>(state_names, this->get_scene().output_control().additional_columns);
     }
 
 
@@ -48,7 +51,8 @@ namespace hysteron
                              group->material,
                              view(state, group->n_state),
                              state_names.size(),
-                             r);
+                             r,
+                             this->get_scene().output_control().additional_columns);
     }
 
 
@@ -79,7 +83,7 @@ namespace hysteron
       std::sort(table.begin(), table.end());
       std::vector<std::string> header{"id", "body"};
       header.insert(header.end(), columns.begin(), columns.end());
-      Output::CsvWriter out(this->output_file("particles.csv"), header);
+      Output::CsvWriter out(this->output_file("particles.csv"), header, &this->run_record());
       for (const auto &row : table)
         out.add_row(row);
       out.commit();

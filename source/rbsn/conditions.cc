@@ -85,7 +85,7 @@ namespace hysteron
             // The same DoF's history under either condition (prescribed_increment() reads
             // only the set's boundary), translations and rotations alike.
             const unsigned int k = dof % n_dofs;
-            static const char *axes[3] = {"x", "y", "z"};
+            static const char *const axes[3] = {"x", "y", "z"};
             const std::string  name = k < dim ? std::string(axes[k]) :
                                       dim == 2 ? std::string("rotation") :
                                                  "rotation about " + std::string(axes[k - dim]);

@@ -167,7 +167,7 @@ namespace hysteron
     void
     Model<dim>::open_tables()
     {
-      tables.open(scene, method.output_directory(), point_columns());
+      tables.open(scene, method.output_directory(), point_columns(), method.run_record());
       if (!scene.is_root())
         return;
       if (analysis == Analysis::variable_order)
@@ -175,10 +175,11 @@ namespace hysteron
           method.output_file("ida.csv"),
           std::vector<std::string>{"time", "steps", "order", "step", "residuals", "jacobians",
                                    "nonlinear_iterations", "error_test_failures",
-                                   "convergence_failures"});
+                                   "convergence_failures"},
+          method.run_record());
       else if (analysis != Analysis::linear_static)
         newton_table =
-          std::make_unique<Output::TimeTable>(method.output_file("newton.csv"), newton_columns());
+          std::make_unique<Output::TimeTable>(method.output_file("newton.csv"), newton_columns(), method.run_record());
       if (fracture.enabled)
         {
           std::vector<std::string> columns{"time", "facet", "x", "y"};
@@ -188,7 +189,8 @@ namespace hysteron
           if (dim == 3)
             columns.push_back("separated_z");
           columns.push_back("released_cells");
-          fracture_table = std::make_unique<Output::TimeTable>(method.output_file("fracture.csv"), columns);
+          fracture_table =
+            std::make_unique<Output::TimeTable>(method.output_file("fracture.csv"), columns, method.run_record());
         }
     }
 
@@ -380,7 +382,7 @@ namespace hysteron
       std::vector<std::vector<double>> ordered(n_global_facets);
       for (std::size_t k = 0; k + width <= all.size(); k += width)
         ordered[static_cast<std::size_t>(all[k])].assign(all.begin() + k + 1, all.begin() + k + width);
-      Output::CsvWriter out(method.output_file("springs.csv"), columns);
+      Output::CsvWriter out(method.output_file("springs.csv"), columns, &method.run_record());
       for (const auto &row : ordered)
         out.add_row(row);
       out.commit();
@@ -418,7 +420,7 @@ namespace hysteron
       std::vector<std::vector<double>> ordered(n_cells);
       for (std::size_t k = 0; k + columns.size() <= all.size(); k += columns.size())
         ordered[static_cast<std::size_t>(all[k])].assign(all.begin() + k, all.begin() + k + columns.size());
-      Output::CsvWriter out(method.output_file("cells.csv"), columns);
+      Output::CsvWriter out(method.output_file("cells.csv"), columns, &method.run_record());
       for (const auto &row : ordered)
         out.add_row(row);
       out.commit();

@@ -25,7 +25,7 @@ namespace hysteron
     Solver<dim>::parse_parameters(dealii::ParameterHandler &prm)
     {
       // The network's tables have cell and facet columns, not continuum points.
-      require(PointData::additional_columns<dim>().empty(),
+      require(this->get_scene().output_control().additional_columns.empty(),
               "Output/Additional columns",
               "the rbsn method's probe tables hold cell and facet values; additional point "
               "columns apply to the mpm and fem methods");

@@ -13,6 +13,7 @@
 
 #include "run/output_directory.h"
 #include "run/parameter_file.h"
+#include "run/signals.h"
 
 #include <algorithm>
 #include <chrono>
@@ -148,10 +149,12 @@ namespace hysteron
     void
     run_scene(dealii::ParameterHandler &prm, const RunOptions &options)
     {
-      auto scene = std::make_unique<Scene<dim>>(prm, options);
+      // The record of the run's files outlives the scene, whose tables it knows.
+      Output::RunRecord record;
+      auto              scene = std::make_unique<Scene<dim>>(prm, options);
       try
         {
-          Run::run_scene(*scene);
+          Run::run_scene(*scene, record);
         }
       catch (...)
         {
@@ -168,6 +171,7 @@ namespace hysteron
       RunOptions  options;
       for (int i = 0; i < argc; ++i)
         options.command_line += (i ? " " : "") + std::string(argv[i]);
+      options.test_signal = Run::test_signal_from_environment();
       bool        print_parameters = false;
       bool        compare          = false;
       std::string format           = "prm";

@@ -2,6 +2,7 @@
 #define hysteron_source_run_checkpoint_files_h
 
 #include <hysteron/base/checkpoint.h>
+#include <hysteron/base/run_record.h>
 
 #include <boost/serialization/string.hpp>
 #include <boost/serialization/utility.hpp>
@@ -87,12 +88,8 @@ namespace hysteron
      * Collective.
      */
     CheckpointFile
-    find_resumable_checkpoint(const std::string             &directory,
-                              const std::string             &method,
-                              const std::string             &parameters,
-                              const std::vector<FileDigest> &inputs,
-                              MPI_Comm                       comm,
-                              std::ostream                  &notes);
+    find_resumable_checkpoint(const std::string &directory, const std::string &method, const std::string &parameters,
+                              const std::vector<FileDigest> &inputs, MPI_Comm comm, std::ostream &notes);
 
     /**
      * What the driver and the method read on resume: global.bin (read on rank 0,
@@ -138,8 +135,10 @@ namespace hysteron
      * rank stream and the checkpoint's directory for distributed files; then the
      * digests of the files, of the time tables (@p tables: path relative to
      * @p directory and length, on rank 0) and of @p inputs go to info.txt and the
-     * checkpoint is published. Keeps the newest @p keep checkpoints. Collective;
-     * throws RuntimeError on every rank if any rank failed.
+     * checkpoint is published, listed in the run's @p record. Keeps the newest
+     * @p keep checkpoints. Collective; throws RuntimeError on every rank if any
+     * rank failed. (checkpoint_info.cc: the names, info.txt and digests;
+     * checkpoint_write.cc: this; checkpoint_resume.cc: finding and reading one.)
      */
     void
     write_checkpoint(
@@ -150,6 +149,7 @@ namespace hysteron
       unsigned int                                                               keep,
       const std::map<std::string, std::uint64_t>                                &tables,
       const std::vector<FileDigest>                                             &inputs,
+      Output::RunRecord                                                         &record,
       const std::function<void(CheckpointWriter &, CheckpointWriter &, const CheckpointDirectory &)> &write);
   } // namespace Run
 } // namespace hysteron

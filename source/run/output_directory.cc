@@ -310,7 +310,6 @@ namespace hysteron
       if (!problem.empty())
         throw InputError("Output/Directory", problem);
 
-      auto &record = Output::RunRecord::get();
       record.begin(directory, root, [this]() { write_manifest(); });
       if (resume)
         {
@@ -355,7 +354,7 @@ namespace hysteron
       m << "  \"status\": " << json(status) << ",\n"
         << "  \"message\": " << json(message) << ",\n"
         << "  \"files\": [\n";
-      const auto &files = Output::RunRecord::get().files();
+      const auto &files = record.files();
       std::size_t i     = 0;
       for (const auto &f : files)
         m << "    " << json(f) << (++i < files.size() ? ",\n" : "\n");
@@ -391,7 +390,7 @@ namespace hysteron
         {
           failure = e.what();
         }
-      Output::RunRecord::get().end();
+      record.end();
       if (lock_fd >= 0)
         {
           ::flock(lock_fd, LOCK_UN);

@@ -4,6 +4,7 @@
 #include <mpi.h>
 
 #include <hysteron/base/checkpoint.h>
+#include <hysteron/base/run_record.h>
 
 #include <string>
 
@@ -30,11 +31,17 @@ namespace hysteron
      *    status and every file the run wrote, rewritten when a file is added;
      *  - hygiene: the files that the previous run's manifest lists are removed
      *    before a new run writes (not on --resume), so nothing stale looks current.
-     * Rank 0 does the work; every rank learns of a problem (an InputError).
+     * Rank 0 does the work; every rank learns of a problem (an InputError). The
+     * files of the manifest are those of the run's @p record, which open() starts
+     * and close() ends.
      */
     class OutputDirectory
     {
     public:
+      explicit OutputDirectory(Output::RunRecord &record)
+        : record(record)
+      {}
+
       /// Before set-up: refuse a directory that cannot be created or written, or that a
       /// running process holds. Creates nothing.
       static void
@@ -64,11 +71,12 @@ namespace hysteron
       void
       write_manifest() const;
 
-      std::string    directory;
-      RunDescription run;
-      bool           root = false;
-      int            lock_fd = -1;
-      std::string    started, status = "running", message, resumed;
+      Output::RunRecord &record;
+      std::string        directory;
+      RunDescription     run;
+      bool               root    = false;
+      int                lock_fd = -1;
+      std::string        started, status = "running", message, resumed;
     };
   } // namespace Run
 } // namespace hysteron

@@ -17,7 +17,7 @@ namespace hysteron
   {
     template <int dim>
     void
-    run_scene(Scene<dim> &scene)
+    run_scene(Scene<dim> &scene, Output::RunRecord &record)
     {
       const MPI_Comm     comm    = scene.mpi_communicator();
       const RunOptions  &options = scene.run_options();
@@ -48,7 +48,7 @@ namespace hysteron
           resume_point.saved_ranks = checkpoint.ranks;
           resume_point.n_ranks     = dealii::Utilities::MPI::n_mpi_processes(comm);
         }
-      method.set_run_context(inputs, resume_point);
+      method.set_run_context(inputs, resume_point, record);
 
       dealii::Timer wall;
       wall.start();
@@ -76,10 +76,10 @@ namespace hysteron
       description.method         = name;
       description.n_ranks        = dealii::Utilities::MPI::n_mpi_processes(comm);
       description.inputs         = inputs;
-      OutputDirectory directory;
+      OutputDirectory directory(record);
       directory.open(directory_name, description, options.resume, comm);
       if (scene.is_root())
-        Output::write_file(scene.output_file("parameters.prm"), scene.effective_parameters());
+        Output::write_file(scene.output_file("parameters.prm"), scene.effective_parameters(), &record);
 
       try
         {
@@ -107,8 +107,8 @@ namespace hysteron
     }
 
     template void
-    run_scene<2>(Scene<2> &);
+    run_scene<2>(Scene<2> &, Output::RunRecord &);
     template void
-    run_scene<3>(Scene<3> &);
+    run_scene<3>(Scene<3> &, Output::RunRecord &);
   } // namespace Run
 } // namespace hysteron

@@ -13,6 +13,9 @@ namespace hysteron
   {
     namespace
     {
+      // Static storage, the one exception to the run's objects (doc/architecture.md): a
+      // signal handler can reach no object and may only store to a volatile sig_atomic_t.
+      // The driver reads it after each step.
       volatile std::sig_atomic_t signal_received = 0;
 
       extern "C" void
@@ -54,22 +57,32 @@ namespace hysteron
       return values[0];
     }
 
-    void
-    test_signal_after_step(const unsigned long step)
+    RunOptions::TestSignal
+    test_signal_from_environment()
     {
-      static const char *spec = std::getenv("HYSTERON_TEST_SIGNAL");
+      RunOptions::TestSignal hook;
+      const char            *spec = std::getenv("HYSTERON_TEST_SIGNAL");
       if (spec == nullptr)
-        return;
+        return hook;
       const std::string text(spec);
       const auto        at = text.find('@');
-      if (at == std::string::npos || std::stoul(text.substr(at + 1)) != step)
-        return;
+      if (at == std::string::npos)
+        return hook;
       const std::string name = text.substr(0, at);
-      const int signal = name == "SIGKILL" ? SIGKILL : name == "SIGTERM" ? SIGTERM : SIGINT;
-      if (signal == SIGKILL)
+      hook.signal = name == "SIGKILL" ? SIGKILL : name == "SIGTERM" ? SIGTERM : SIGINT;
+      hook.step   = std::stoul(text.substr(at + 1));
+      return hook;
+    }
+
+    void
+    test_signal_after_step(const RunOptions::TestSignal &hook, const unsigned long step, Output::RunRecord &record)
+    {
+      if (hook.signal == 0 || hook.step != step)
+        return;
+      if (hook.signal == SIGKILL)
         // What a crash leaves: the rows written so far reach the files, then nothing.
-        Output::RunRecord::get().flush_tables();
-      std::raise(signal);
+        record.flush_tables();
+      std::raise(hook.signal);
     }
   } // namespace Run
 } // namespace hysteron

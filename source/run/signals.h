@@ -3,6 +3,9 @@
 
 #include <mpi.h>
 
+#include <hysteron/base/run_record.h>
+#include <hysteron/scene/scene.h>
+
 namespace hysteron
 {
   namespace Run
@@ -25,10 +28,16 @@ namespace hysteron
     int
     received_signal(MPI_Comm comm, unsigned int n_ranks, bool &any_due_on_root);
 
-    /// Test hook: HYSTERON_TEST_SIGNAL=<SIGINT|SIGTERM|SIGKILL>@<step> raises the
-    /// signal in this process after that step's outputs (see tests/run/).
+    /// The test hook of the environment variable HYSTERON_TEST_SIGNAL
+    /// (<SIGINT|SIGTERM|SIGKILL>@<step>; unset: none), read once at start-up.
+    RunOptions::TestSignal
+    test_signal_from_environment();
+
+    /// The test hook: raise @p hook's signal in this process if @p step is its step
+    /// (see tests/run/). Before a SIGKILL the rows of the tables of @p record reach
+    /// their files, as after a crash.
     void
-    test_signal_after_step(unsigned long step);
+    test_signal_after_step(const RunOptions::TestSignal &hook, unsigned long step, Output::RunRecord &record);
   } // namespace Run
 } // namespace hysteron
 

@@ -128,7 +128,7 @@ namespace hysteron
     {
       output_fields(loop->time);
       write_rows(loop->time);
-      Output::RunRecord::get().flush_tables();
+      this->run_record().flush_tables();
     }
 
     template <int dim>
@@ -136,7 +136,7 @@ namespace hysteron
     SteppingMethod<dim>::save_checkpoint()
     {
       const Scene<dim> &scene = this->get_scene();
-      auto             &record = Output::RunRecord::get();
+      auto             &record = this->run_record();
       dealii::TimerOutput::Scope timing(scene.timer(), "checkpoint");
       // The tables' rows up to here are on disk before the checkpoint that counts them.
       record.sync_tables();
@@ -149,6 +149,7 @@ namespace hysteron
                        scene.checkpoint_control().keep,
                        sizes,
                        this->inputs(),
+                       record,
                        [&](CheckpointWriter &global, CheckpointWriter &rank, const CheckpointDirectory &directory) {
                          write_resume_header(global, scene.method_name(), scene.effective_parameters());
                          global.put(t);
@@ -182,7 +183,7 @@ namespace hysteron
       if (loop->fields.due(t, last))
         output_fields(t);
       loop->progress.update(steps, t);
-      test_signal_after_step(steps);
+      test_signal_after_step(scene.run_options().test_signal, steps, this->run_record());
 
       // One reduction (on several ranks) decides signals and wall-clock checkpoints.
       bool wall_due = scene.is_root() && control.wall_minutes > 0 &&
@@ -215,7 +216,7 @@ namespace hysteron
       MPI_Comm           comm      = scene.mpi_communicator();
       const std::string  name      = label();
       const std::string  directory = this->output_directory();
-      auto              &record    = Output::RunRecord::get();
+      auto              &record    = this->run_record();
       loop = std::make_unique<Loop>(scene, name);
       double t = 0;
 
@@ -246,7 +247,7 @@ namespace hysteron
         }
 
       open_outputs();
-      field_writer = std::make_unique<Output::FieldWriter>(directory, field_name(), comm);
+      field_writer = std::make_unique<Output::FieldWriter>(directory, field_name(), comm, &record);
       record.set_resume_sizes({});
       loop->time = t;
       if (resume)

@@ -117,7 +117,7 @@ namespace hysteron
                                 const unsigned int        c,
                                 const dealii::Point<dim> &x)
   {
-    static const char *names[3] = {"x", "y", "z"};
+    static const char *const names[3] = {"x", "y", "z"};
     const auto         history  = [&](const unsigned int i) {
       return [&, i](const double t) {
         const auto &d = conditions[i];

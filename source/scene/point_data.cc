@@ -13,7 +13,7 @@ namespace hysteron
 
     template <int dim>
     std::vector<std::string>
-    columns(const std::vector<std::string> &state_names)
+    columns(const std::vector<std::string> &state_names, const ColumnSelection<dim> &additional)
     {
       constexpr unsigned int   n_sym = dealii::SymmetricTensor<2, dim>::n_independent_components;
       std::vector<std::string> c;
@@ -31,9 +31,8 @@ namespace hysteron
             c.push_back("von_mises");
         }
       c.insert(c.end(), state_names.begin(), state_names.end());
-      for (const auto &column : additional_columns<dim>())
-        for (const auto &name : column->names())
-          c.push_back(name);
+      const auto more = additional.names();
+      c.insert(c.end(), more.begin(), more.end());
       return c;
     }
 
@@ -59,7 +58,8 @@ namespace hysteron
            const Material::Interface<dim>        *material,
            const dealii::ArrayView<const double> &state,
            const unsigned int                     n_state_columns,
-           double                                *out)
+           double                                *out,
+           const ColumnSelection<dim>            &additional)
     {
       constexpr unsigned int n_sym = dealii::SymmetricTensor<2, dim>::n_independent_components;
       unsigned int           c     = 0;
@@ -80,9 +80,8 @@ namespace hysteron
       for (unsigned int k = 0; k < n_state_columns; ++k)
         out[c++] = (material != nullptr && k < state.size()) ? state[k] : 0.0;
       // The plugins of `Output/Additional columns`.
-      if (!additional_columns<dim>().empty())
-        evaluate_additional_columns<dim>({x, u, v, stress, strain, material, state, sigma_zz},
-                                         out + c);
+      if (!additional.empty())
+        additional.evaluate({x, u, v, stress, strain, material, state, sigma_zz}, out + c);
     }
 
 
@@ -165,7 +164,8 @@ namespace hysteron
 
 
 #define HYSTERON_INSTANTIATE(dim)                                                              \
-  template std::vector<std::string> columns<dim>(const std::vector<std::string> &);            \
+  template std::vector<std::string> columns<dim>(const std::vector<std::string> &,             \
+                                                 const ColumnSelection<dim> &);                \
   template double von_mises<dim>(const dealii::SymmetricTensor<2, dim> &, double);            \
   template void   values<dim>(const dealii::Point<dim> &,                                      \
                             const dealii::Tensor<1, dim> &,                                    \
@@ -175,7 +175,8 @@ namespace hysteron
                             const Material::Interface<dim> *,                                  \
                             const dealii::ArrayView<const double> &,                           \
                             unsigned int,                                                      \
-                            double *);                                                         \
+                            double *,                                                          \
+                            const ColumnSelection<dim> &);                                     \
   template double strain_energy_density<dim>(const Material::Interface<dim> &,                 \
                                              const dealii::SymmetricTensor<2, dim> &,          \
                                              const dealii::SymmetricTensor<2, dim> &,          \

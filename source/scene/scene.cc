@@ -295,8 +295,7 @@ namespace hysteron
       output.probe_points      = parse_points<dim>(s.get("Probe points"), s.where("Probe points"));
       output.progress_interval = s.get_positive("Progress interval");
       output.probe_interval    = s.get_non_negative("Probe interval");
-      PointData::select_additional_columns<dim>(s.get_list("Additional columns"),
-                                                s.where("Additional columns"));
+      output.additional_columns.select(s.get_list("Additional columns"), s.where("Additional columns"));
       for (const auto &expression :
            dealii::Utilities::split_string_list(s.get("Average regions"), ';'))
         if (!expression.empty())

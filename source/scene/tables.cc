@@ -18,8 +18,10 @@ namespace hysteron
     void
     Tables<dim>::open(const Scene<dim>               &scene,
                       const std::string              &directory,
-                      const std::vector<std::string> &point)
+                      const std::vector<std::string> &point,
+                      Output::RunRecord              &run_record)
     {
+      record           = &run_record;
       n_values         = point.size();
       point_names      = point;
       reaction_names   = reaction_columns(scene);
@@ -34,24 +36,25 @@ namespace hysteron
           std::vector<std::string> c{"time"};
           c.insert(c.end(), point.begin(), point.end());
           probe_tables.push_back(
-            std::make_unique<Output::TimeTable>(file("probe_" + std::to_string(i) + ".csv"), c));
+            std::make_unique<Output::TimeTable>(file("probe_" + std::to_string(i) + ".csv"), c, run_record));
         }
       for (unsigned int i = 0; i < scene.output_control().average_regions.size(); ++i)
         {
           std::vector<std::string> c{"time", "mass"};
           c.insert(c.end(), point.begin(), point.end());
           average_tables.push_back(
-            std::make_unique<Output::TimeTable>(file("average_" + std::to_string(i) + ".csv"), c));
+            std::make_unique<Output::TimeTable>(file("average_" + std::to_string(i) + ".csv"), c, run_record));
         }
-      energy_table   = std::make_unique<Output::TimeTable>(file("energy.csv"), energy_columns());
-      reaction_table = std::make_unique<Output::TimeTable>(file("reactions.csv"), reaction_columns(scene));
+      energy_table   = std::make_unique<Output::TimeTable>(file("energy.csv"), energy_columns(), run_record);
+      reaction_table =
+        std::make_unique<Output::TimeTable>(file("reactions.csv"), reaction_columns(scene), run_record);
       std::vector<std::string> c{"time"};
       for (const auto &name : history_columns())
         c.push_back(name);
       for (const auto &name : history_names)
         {
           history_paths.push_back(file("history_" + name + ".csv"));
-          history_tables.push_back(std::make_unique<Output::TimeTable>(history_paths.back(), c));
+          history_tables.push_back(std::make_unique<Output::TimeTable>(history_paths.back(), c, run_record));
         }
     }
 
@@ -126,7 +129,7 @@ namespace hysteron
              << "set output\n";
           gp.close();
           const std::string warning =
-            Plot::run_gnuplot((csv.parent_path() / (stem + ".gp")).string(), stem + ".png", timeout);
+            Plot::run_gnuplot((csv.parent_path() / (stem + ".gp")).string(), stem + ".png", timeout, record);
           if (!warning.empty())
             warnings.push_back(warning);
         }

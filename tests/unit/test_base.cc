@@ -315,10 +315,11 @@ TEST(Scene, RunsAMaterialPointSceneInProcess)
 
   RunOptions options;
   options.quiet = true;
-  Scene<3> scene(prm, options);
+  Output::RunRecord record;
+  Scene<3>          scene(prm, options);
   EXPECT_EQ(scene.material_names(), (std::vector<std::string>{"", "soft"}));
   EXPECT_THROW(scene.material("hard", "Body/Material"), InputError);
-  Run::run_scene(scene);
+  Run::run_scene(scene, record);
 
   const std::string csv = read(d + "/history.csv");
   EXPECT_EQ(csv.substr(0, csv.find('\n')),

@@ -15,6 +15,8 @@ namespace hysteron
 {
   namespace Output
   {
+    class RunRecord;
+
     /**
      * Create @p directory (with parents) and check that we can write into it.
      * Throws InputError at @p where ("Output/Directory") otherwise.
@@ -22,12 +24,6 @@ namespace hysteron
     void
     prepare_directory(const std::string &directory, const std::string &where);
 
-    /**
-     * A file that appears under its final name only when complete: the content
-     * goes to "<name>.tmp", commit() closes and renames it. A file that is never
-     * committed (an exception, a failed run) is removed, so a reader never sees
-     * a half-written output.
-     */
     /**
      * The inline binary form of a VTK XML DataArray (format="binary", header_type="UInt64"):
      * the base64 encoding of the array's byte count (8 bytes, little-endian) followed by
@@ -44,10 +40,17 @@ namespace hysteron
       write_base64(out, values.data(), values.size() * sizeof(values[0]));
     }
 
+    /**
+     * A file that appears under its final name only when complete: the content
+     * goes to "<name>.tmp", commit() closes and renames it. A file that is never
+     * committed (an exception, a failed run) is removed, so a reader never sees
+     * a half-written output. A file of a run is given the run's @p record, which
+     * lists it once committed (null: a file outside a run).
+     */
     class AtomicFile
     {
     public:
-      explicit AtomicFile(const std::string &filename);
+      explicit AtomicFile(const std::string &filename, RunRecord *record = nullptr);
       ~AtomicFile();
 
       AtomicFile(const AtomicFile &) = delete;
@@ -81,14 +84,15 @@ namespace hysteron
     private:
       std::string   final_name;
       std::string   temporary_name;
+      RunRecord    *record;
       std::ofstream out;
       bool          committed = false;
       int           error     = 0; ///< errno when the writer stopped on a failed stream
     };
 
-    /// Write @p content to @p filename atomically.
+    /// Write @p content to @p filename atomically (an AtomicFile of @p record).
     void
-    write_file(const std::string &filename, const std::string &content);
+    write_file(const std::string &filename, const std::string &content, RunRecord *record = nullptr);
 
     /**
      * A CSV table written whole at the end of a run (particles.csv, springs.csv):
@@ -98,7 +102,9 @@ namespace hysteron
     class CsvWriter
     {
     public:
-      CsvWriter(const std::string &filename, const std::vector<std::string> &columns);
+      CsvWriter(const std::string              &filename,
+                const std::vector<std::string> &columns,
+                RunRecord                      *record = nullptr);
 
       std::size_t
       n_columns() const
@@ -133,7 +139,7 @@ namespace hysteron
      * every half second of wall time (or 64 KiB), at flush(), at a checkpoint and
      * at the end of the run; the file never ends inside a row.
      *
-     * Every open time table is known to the RunRecord: a checkpoint records the
+     * Every open time table is known to the run's RunRecord: a checkpoint records the
      * length and CRC of each (after sync()), and a resumed run (hysteron --resume)
      * cuts each table back to that length and appends, so that its tables equal
      * an uninterrupted run's; a table shorter than that is refused, never padded.
@@ -141,7 +147,9 @@ namespace hysteron
     class TimeTable
     {
     public:
-      TimeTable(const std::string &filename, const std::vector<std::string> &columns);
+      /// Open the table @p filename of the run of @p record (on resume: cut back to its
+      /// length at the checkpoint).
+      TimeTable(const std::string &filename, const std::vector<std::string> &columns, RunRecord &record);
       ~TimeTable();
 
       TimeTable(const TimeTable &) = delete;
@@ -181,6 +189,7 @@ namespace hysteron
 
     private:
       std::string   name;
+      RunRecord    &record;
       std::size_t   n_columns_ = 0;
       int           fd         = -1;
       std::string   buffer;
@@ -195,11 +204,15 @@ namespace hysteron
      * (a failing run writes its last good state). All files are written
      * atomically. Works for any DataOutInterface: DataOut (FEM, background
      * grid), Particles::DataOut (MPM), or the custom patches of the RBSN cells.
+     * The files are the run's of @p record (null: outside a run).
      */
     class FieldWriter
     {
     public:
-      FieldWriter(const std::string &directory, const std::string &base_name, MPI_Comm comm);
+      FieldWriter(const std::string &directory,
+                  const std::string &base_name,
+                  MPI_Comm           comm,
+                  RunRecord         *record = nullptr);
 
       template <int dim, int spacedim>
       void
@@ -249,6 +262,7 @@ namespace hysteron
       std::string                                 directory;
       std::string                                 base_name;
       MPI_Comm                                    comm;
+      RunRecord                                  *record;
       unsigned int                                counter = 0;
       std::vector<std::pair<double, std::string>> times_and_names;
     };

@@ -6,6 +6,11 @@
 
 namespace hysteron
 {
+  namespace Output
+  {
+    class RunRecord;
+  }
+
   /// External plotters (gnuplot) run without a shell, with a timeout, drawing a PNG
   /// under a temporary name that is renamed once the plotter has succeeded.
   namespace Plot
@@ -27,6 +32,9 @@ namespace hysteron
 
       /// Seconds it may run (> 0).
       double timeout = 60;
+
+      /// The run whose file the PNG is (null: outside a run).
+      Output::RunRecord *record = nullptr;
     };
 
     /**
@@ -54,10 +62,14 @@ namespace hysteron
      * empty string if the PNG was drawn and gnuplot printed nothing, else a
      * warning: gnuplot not on PATH, failed or timed out (then neither the PNG of
      * an earlier run nor a temporary file is left under @p png_file), or what
-     * gnuplot printed. Never throws because of gnuplot.
+     * gnuplot printed. Never throws because of gnuplot. The PNG is a file of the
+     * run of @p record (null: outside a run).
      */
     std::string
-    run_gnuplot(const std::string &script_file, const std::string &png_file, double timeout = 60);
+    run_gnuplot(const std::string &script_file,
+                const std::string &png_file,
+                double             timeout = 60,
+                Output::RunRecord *record  = nullptr);
   } // namespace Plot
 } // namespace hysteron
 

@@ -15,22 +15,27 @@ namespace hysteron
     class TimeTable;
 
     /**
-     * What one run writes into its output directory, known to every writer of
-     * the process (there is one run per process):
+     * What one run writes into its output directory. The run owns it
+     * (Run::run_scene() creates it) and hands it by reference to the writers of
+     * its files (AtomicFile, TimeTable, FieldWriter, the plotter), the output
+     * directory and the checkpoints:
      *  - the files written, relative to the output directory, for the run's
      *    manifest (a later run removes them before it starts, so that no file
      *    of an earlier run looks current);
      *  - the time tables that are open, which a checkpoint flushes and
      *    measures, and which a resumed run cuts back to their length at the
      *    checkpoint before it appends.
-     * Outside a run (unit tests, the compare tool on its own) it records nothing.
+     * Until begin() (and after end()) it records nothing; a file written outside
+     * a run (unit tests, the compare tool on its own) is given no record at all.
      */
     class RunRecord
     {
     public:
-      /// The record of this process.
-      static RunRecord &
-      get();
+      RunRecord() = default;
+
+      RunRecord(const RunRecord &) = delete;
+      RunRecord &
+      operator=(const RunRecord &) = delete;
 
       /// Start recording the files under @p directory; only @p root writes the manifest.
       void
@@ -99,8 +104,6 @@ namespace hysteron
       relative(const std::string &path) const;
 
     private:
-      RunRecord() = default;
-
       bool                                 recording = false;
       bool                                 root      = false;
       std::string                          directory;

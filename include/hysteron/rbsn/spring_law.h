@@ -33,9 +33,9 @@ namespace hysteron
     inline const char *
     spring_name(const unsigned int i)
     {
-      static const char *names_2d[] = {"normal", "tangential", "rotational"};
-      static const char *names_3d[] = {"normal", "first shear", "second shear", "first bending",
-                                       "second bending", "torsion"};
+      static const char *const names_2d[] = {"normal", "tangential", "rotational"};
+      static const char *const names_3d[] = {"normal", "first shear", "second shear", "first bending",
+                                             "second bending", "torsion"};
       return dim == 2 ? names_2d[i] : names_3d[i];
     }
 

@@ -5,6 +5,7 @@
 
 #include <hysteron/base/checkpoint.h>
 #include <hysteron/base/registry.h>
+#include <hysteron/base/run_record.h>
 
 #include <string>
 #include <vector>
@@ -92,16 +93,27 @@ namespace hysteron
 
       /**
        * Set by the runner before setup(): the run's input files as read (their
-       * digests go into every checkpoint), and with `--resume` the checkpoint the
+       * digests go into every checkpoint), with `--resume` the checkpoint the
        * run continues from, found and checked before setup() so that a method
        * can build its set-up from it (e.g. a triangulation saved with its cells'
-       * data).
+       * data), and the record of the run's files, which outlives the method's run.
        */
       void
-      set_run_context(const std::vector<FileDigest> &inputs, const CheckpointDirectory &resume)
+      set_run_context(const std::vector<FileDigest> &inputs,
+                      const CheckpointDirectory     &resume,
+                      Output::RunRecord             &record)
       {
         input_digests = inputs;
         resume_point  = resume;
+        files         = &record;
+      }
+
+      /// The record of the run's files (set_run_context()): every file the method writes is given it.
+      Output::RunRecord &
+      run_record() const
+      {
+        Assert(files != nullptr, dealii::ExcMessage("run_record() before set_run_context()"));
+        return *files;
       }
 
       /// Whether the run continues from a checkpoint (resume_from()).
@@ -151,6 +163,7 @@ namespace hysteron
       std::string             subdirectory;
       std::vector<FileDigest> input_digests;
       CheckpointDirectory     resume_point;
+      Output::RunRecord      *files = nullptr;
     };
 
     template <int dim>

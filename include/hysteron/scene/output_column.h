@@ -9,6 +9,7 @@
 #include <hysteron/base/registry.h>
 #include <hysteron/material/interface.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -76,21 +77,39 @@ namespace hysteron
     template <int dim>
     using ColumnRegistry = Plugins::Registry<Column<dim>>;
 
-    /// The columns a scene asked for (`Output/Additional columns`), in the order given.
+    /**
+     * The columns a scene asked for (`Output/Additional columns`), in the order
+     * given. Each scene holds its own (OutputControl::additional_columns): two
+     * scenes of one process never share a selection.
+     */
     template <int dim>
-    const std::vector<std::unique_ptr<Column<dim>>> &
-    additional_columns();
+    class ColumnSelection
+    {
+    public:
+      /// Select the columns by name (the Scene does this when it reads the parameters;
+      /// @p where is the parameter path for errors).
+      void
+      select(const std::vector<std::string> &names, const std::string &where);
 
-    /// Write the values of every additional column of @p point into @p out.
-    template <int dim>
-    void
-    evaluate_additional_columns(const PointView<dim> &point, double *out);
+      bool
+      empty() const
+      {
+        return columns.empty();
+      }
 
-    /// Select the additional columns by name (the Scene does this when it reads the
-    /// parameters; @p where is the parameter path for errors).
-    template <int dim>
-    void
-    select_additional_columns(const std::vector<std::string> &names, const std::string &where);
+      /// The names of the values of every selected column, in order.
+      std::vector<std::string>
+      names() const;
+
+      /// Write the values of every selected column of @p point into @p out.
+      void
+      evaluate(const PointView<dim> &point, double *out) const;
+
+    private:
+      std::vector<std::shared_ptr<const Column<dim>>> columns;
+      /// The number of values of each column (names() allocates).
+      std::vector<unsigned int> widths;
+    };
   } // namespace PointData
 } // namespace hysteron
 

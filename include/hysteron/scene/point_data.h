@@ -7,6 +7,7 @@
 #include <deal.II/base/tensor.h>
 
 #include <hysteron/material/interface.h>
+#include <hysteron/scene/output_column.h>
 
 #include <array>
 #include <string>
@@ -37,10 +38,10 @@ namespace hysteron
     extern const char *const component_names[3];
 
     /// The columns of a point, without `time`: the fixed ones, the state variables, then
-    /// the plugins selected in `Output/Additional columns` (output_column.h).
+    /// the scene's @p additional columns (`Output/Additional columns`, output_column.h).
     template <int dim>
     std::vector<std::string>
-    columns(const std::vector<std::string> &state_names);
+    columns(const std::vector<std::string> &state_names, const ColumnSelection<dim> &additional);
 
     /// The von Mises stress sqrt(3/2 dev(s):dev(s)) of @p stress with the out-of-plane @p sigma_zz (2D).
     template <int dim>
@@ -51,8 +52,8 @@ namespace hysteron
      * The values of a point in the order of columns(): position @p x,
      * displacement @p u, velocity @p v, stress, von Mises, strain and the first
      * @p n_state_columns state variables (missing ones are 0; a null @p material
-     * is a rigid point without stress state), then the additional columns
-     * (output_column.h).
+     * is a rigid point without stress state), then the scene's @p additional
+     * columns (output_column.h).
      */
     template <int dim>
     void
@@ -64,7 +65,8 @@ namespace hysteron
            const Material::Interface<dim>         *material,
            const dealii::ArrayView<const double>  &state,
            const unsigned int                      n_state_columns,
-           double                                 *out);
+           double                                 *out,
+           const ColumnSelection<dim>             &additional);
 
     /**
      * The elastic strain energy density [J/m^3] of @p stress,

@@ -10,6 +10,7 @@
 #include <hysteron/material/interface.h>
 #include <hysteron/scene/description.h>
 #include <hysteron/scene/method.h>
+#include <hysteron/scene/output_column.h>
 
 #include <map>
 #include <memory>
@@ -64,6 +65,8 @@ namespace hysteron
     /// `History sets`: the sets (indices into Scene::set_descriptions()) whose
     /// load-displacement history is written to history_<name>.csv (the fem method).
     std::vector<unsigned int> history_sets;
+    /// `Additional columns`: the output column plugins of this scene's point tables.
+    PointData::ColumnSelection<dim> additional_columns;
   };
 
   /// `subsection Checkpoint`: when a time-stepping method saves its state.
@@ -90,6 +93,14 @@ namespace hysteron
     MPI_Comm    comm  = MPI_COMM_WORLD;
     /// The files read before the scene: the parameter file, its includes, libraries.
     std::vector<std::string> input_files;
+    /// Test hook, read once at start-up from HYSTERON_TEST_SIGNAL=<SIGINT|SIGTERM|SIGKILL>@<step>
+    /// (tests/run/, tests/fuzz/): the run raises @p signal in itself after the outputs of
+    /// step @p step.
+    struct TestSignal
+    {
+      int           signal = 0; ///< 0: none
+      unsigned long step   = 0;
+    } test_signal;
   };
 
   /**

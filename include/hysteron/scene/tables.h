@@ -31,11 +31,13 @@ namespace hysteron
     public:
       /// Open the tables in @p directory (rank 0): one probe table per probe point of
       /// the scene, one average table per average region, with the @p point_columns
-      /// (PointData::columns() for material points and quadrature points).
+      /// (PointData::columns() for material points and quadrature points), as files
+      /// of the run of @p record.
       void
       open(const Scene<dim>               &scene,
            const std::string              &directory,
-           const std::vector<std::string> &point_columns);
+           const std::vector<std::string> &point_columns,
+           Output::RunRecord              &record);
 
       /// The number of values of a point (the probe columns without `time`).
       unsigned int
@@ -92,6 +94,7 @@ namespace hysteron
       serialize(Archive &ar);
 
     private:
+      Output::RunRecord                              *record = nullptr; ///< of open()
       std::vector<std::unique_ptr<Output::TimeTable>> probe_tables, average_tables;
       std::unique_ptr<Output::TimeTable>              energy_table, reaction_table;
       std::vector<std::unique_ptr<Output::TimeTable>> history_tables;
