@@ -30,13 +30,13 @@ namespace hysteron
 
     template <int dim>
     std::string
-    Model<dim>::summary(const unsigned long steps, const unsigned int outputs) const
+    Model<dim>::summary(const unsigned long steps, const unsigned int outputs, const bool resumed) const
     {
       std::ostringstream s;
       s << n_cells << " cells, " << n_global_facets << " facets, "
         << (analysis == Analysis::variable_order ? n_steps : steps) << " steps, " << n_newton
         << " Newton iterations";
-      s << ", " << n_factorizations << " factorizations";
+      s << ", " << n_factorizations << " factorizations" << (resumed ? " since the resume" : "");
       if (incremental_assembly && n_facet_evaluations > 0)
         {
           const MPI_Comm      comm    = network_communicator();

@@ -124,7 +124,7 @@ namespace hysteron
     std::string
     Solver<dim>::summary() const
     {
-      return model ? model->summary(this->n_steps(), this->n_outputs()) : std::string();
+      return model ? model->summary(this->n_steps(), this->n_outputs(), this->resuming()) : std::string();
     }
 
     template class Solver<2>;

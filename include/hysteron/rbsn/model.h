@@ -120,9 +120,10 @@ namespace hysteron
       void
       set_matrix_values(const std::vector<double> &values);
 
-      /// The run's summary, with the driver's counts.
+      /// The run's summary, with the driver's counts (@p resumed: the factorizations are
+      /// this process's, since the resume).
       std::string
-      summary(unsigned long steps, unsigned int outputs) const;
+      summary(unsigned long steps, unsigned int outputs, bool resumed) const;
 
       /// The number of cells of the whole network.
       std::size_t
