@@ -1,4 +1,4 @@
-#include <hysteron/base/direct_solver.h>
+#include "base/direct_solver.h"
 #include <hysteron/base/exceptions.h>
 
 #include <Amesos.h>

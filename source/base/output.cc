@@ -2,7 +2,7 @@
 
 #include <hysteron/base/exceptions.h>
 #include <hysteron/base/output.h>
-#include <hysteron/base/run_record.h>
+#include "base/run_record.h"
 
 #include <algorithm>
 #include <cerrno>

@@ -1,5 +1,5 @@
-#include <hysteron/base/plotter.h>
-#include <hysteron/base/run_record.h>
+#include "base/plotter.h"
+#include "base/run_record.h"
 
 #include <algorithm>
 #include <cerrno>

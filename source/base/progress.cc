@@ -1,4 +1,4 @@
-#include <hysteron/base/progress.h>
+#include "base/progress.h"
 
 #include <algorithm>
 #include <iomanip>

@@ -1,5 +1,5 @@
 #include <hysteron/base/output.h>
-#include <hysteron/base/run_record.h>
+#include "base/run_record.h"
 
 #include <algorithm>
 #include <filesystem>

@@ -1,7 +1,7 @@
 #ifndef hysteron_source_compare_compare_h
 #define hysteron_source_compare_compare_h
 
-#include <hysteron/base/plotter.h>
+#include "base/plotter.h"
 #include <functional>
 #include <string>
 #include <vector>

@@ -10,7 +10,7 @@
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/vector.h>
 
-#include <hysteron/fem/fem.h>
+#include "fem/fem.h"
 
 #include "cell_kernels.h"
 

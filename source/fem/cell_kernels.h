@@ -13,7 +13,7 @@
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/vector.h>
 
-#include <hysteron/fem/fem.h>
+#include "fem/fem.h"
 
 #include <string>
 #include <vector>

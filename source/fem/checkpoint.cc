@@ -8,7 +8,7 @@
 // vectors (every owned DoF lies in an owned cell, and the cells that share it hold
 // the same value), so the state is the checkpoint's bit for bit on any partition; on
 // another number of ranks the partial sums are gathered on rank 0.
-#include <hysteron/fem/fem.h>
+#include "fem/fem.h"
 
 #include "run/record_archive.h"
 #include "run/rank_parts.h"

@@ -15,7 +15,7 @@
 
 #include <hysteron/base/newton.h>
 #include <hysteron/base/parameters.h>
-#include <hysteron/fem/fem.h>
+#include "fem/fem.h"
 #include <hysteron/geometry/mesh.h>
 
 #include "base/implicit_step.h"

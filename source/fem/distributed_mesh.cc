@@ -11,7 +11,7 @@
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/tria_description.h>
 
-#include <hysteron/fem/fem.h>
+#include "fem/fem.h"
 #include <hysteron/geometry/mesh.h>
 
 #include "fem/mesh_file.h"

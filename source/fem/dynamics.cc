@@ -5,7 +5,7 @@
 #include <deal.II/lac/vector.h>
 
 #include <hysteron/base/energy_check.h>
-#include <hysteron/fem/fem.h>
+#include "fem/fem.h"
 
 #include <array>
 #include <cmath>

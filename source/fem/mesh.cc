@@ -22,7 +22,7 @@
 #include <hysteron/base/memory.h>
 #include <hysteron/base/newton.h>
 #include <hysteron/base/parameters.h>
-#include <hysteron/fem/fem.h>
+#include "fem/fem.h"
 #include <hysteron/geometry/mesh.h>
 
 #include <cmath>

@@ -3,7 +3,7 @@
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/numerics/data_out.h>
 
-#include <hysteron/fem/fem.h>
+#include "fem/fem.h"
 
 #include <algorithm>
 #include <cmath>

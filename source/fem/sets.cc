@@ -5,7 +5,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/utilities.h>
 
-#include <hysteron/fem/fem.h>
+#include "fem/fem.h"
 
 #include <algorithm>
 

@@ -6,7 +6,7 @@
 #include <deal.II/grid/grid_tools.h>
 
 #include <hysteron/base/rigid_modes.h>
-#include <hysteron/fem/fem.h>
+#include "fem/fem.h"
 
 #include <algorithm>
 #include <limits>

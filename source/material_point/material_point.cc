@@ -2,7 +2,7 @@
 
 #include <hysteron/base/output.h>
 #include <hysteron/base/parameters.h>
-#include <hysteron/base/progress.h>
+#include "base/progress.h"
 #include <hysteron/material_point/material_point.h>
 
 #include <cmath>

@@ -5,7 +5,7 @@
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/vector.h>
 
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 
 #include <string>
 #include <vector>

@@ -1,5 +1,5 @@
 // The 2D boundary: the oriented boundary of a union of regions, its loops, and the points along it.
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include "rbsn/boundary_2d.h"
 #include "rbsn/spread.h"

@@ -1,6 +1,6 @@
 // The 3D boundary points: those of the sharp edges, then Poisson-disk points on the boundary's planar faces.
 #include <hysteron/base/exceptions.h>
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include "rbsn/poisson_grid_3d.h"
 #include "rbsn/polyhedron.h"

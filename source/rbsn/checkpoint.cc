@@ -6,7 +6,7 @@
 //  - the global state (step control, counters, works, tables);
 //  - each rank's incrementally assembled tangent (its rows of the matrix), used only
 //    on as many ranks: on another number the first step assembles it anew.
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 
 #include <Epetra_CrsMatrix.h>
 

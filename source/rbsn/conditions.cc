@@ -1,7 +1,7 @@
 // The RBSN's conditions: history sets, supports (Dirichlet sets), loads and the constraints.
 #include <deal.II/base/mpi.h>
 
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 
 #include "base/implicit_step.h"
 

@@ -2,7 +2,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/utilities.h>
 
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 #include <hysteron/run/stepping_method.h>
 
 #include <iostream>

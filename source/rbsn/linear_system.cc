@@ -2,7 +2,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 
 #include "base/sparse_lu.h"
 #include "rbsn/collective.h"

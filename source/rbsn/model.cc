@@ -1,5 +1,5 @@
 // The RBSN's model: its construction and the run's summary.
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 
 #include "base/sparse_lu.h"
 

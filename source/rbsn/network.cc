@@ -21,7 +21,7 @@
 
 #include <hysteron/base/exceptions.h>
 #include <hysteron/base/memory.h>
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 
 #include "rbsn/blocks.h"
 #include "rbsn/collective.h"

@@ -3,7 +3,7 @@
 #include <deal.II/base/mpi.h>
 
 #include <hysteron/base/output.h>
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 
 #include "rbsn/collective.h"
 #include "rbsn/rigid_motion.h"

@@ -18,7 +18,7 @@
 #include <deal.II/lac/trilinos_solver.h>
 #include <deal.II/lac/trilinos_vector.h>
 
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 
 #include "base/sparse_lu.h"
 

@@ -2,7 +2,7 @@
 #include <deal.II/base/utilities.h>
 
 #include <hysteron/base/parameters.h>
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 
 #include <cmath>
 #include <cstdlib>

@@ -1,6 +1,6 @@
 // The 2D Poisson-disk sampling: its background grid, Bridson's front and the darts into its gaps.
 #include <hysteron/base/exceptions.h>
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include "rbsn/sampling.h"
 

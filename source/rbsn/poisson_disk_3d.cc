@@ -1,6 +1,6 @@
 // The 3D Poisson-disk sampling: the forbidden balls of the boundary points, Bridson's front and the darts into its gaps.
 #include <hysteron/base/exceptions.h>
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include "rbsn/poisson_grid_3d.h"
 #include "rbsn/polyhedron.h"

@@ -1,7 +1,7 @@
 #ifndef hysteron_source_rbsn_poisson_grid_3d_h
 #define hysteron_source_rbsn_poisson_grid_3d_h
 
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include "rbsn/polyhedron.h"
 

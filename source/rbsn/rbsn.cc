@@ -1,5 +1,5 @@
 // The rbsn method the driver registers: Run::SteppingMethod's hooks on a Model.
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 #include <hysteron/rbsn/rbsn.h>
 #include <hysteron/scene/output_column.h>
 

@@ -3,7 +3,7 @@
 
 #include <deal.II/base/point.h>
 
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include <algorithm>
 #include <array>

@@ -1,5 +1,5 @@
 // The sharp edges of the 3D boundary: where the surface turns, their corners, and the points along them.
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include "rbsn/sharp_edges_3d.h"
 #include "rbsn/spread.h"

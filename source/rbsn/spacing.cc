@@ -1,6 +1,6 @@
 // The minimum distance of the nuclei, d(x): its evaluation and its sampling over the bodies.
 #include <hysteron/base/exceptions.h>
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include <algorithm>
 #include <array>

@@ -1,7 +1,7 @@
 // The facets' springs: their stiffnesses, kinematics (B), laws, and the cells' DoFs and mass.
 #include <deal.II/base/mpi.h>
 
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 
 #include <cmath>
 #include <sstream>

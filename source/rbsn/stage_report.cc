@@ -1,5 +1,5 @@
 // StageReport: the console lines of a large network's set-up, one per stage.
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include <iomanip>
 #include <sstream>

@@ -3,7 +3,7 @@
 #include <deal.II/base/utilities.h>
 #include <deal.II/lac/full_matrix.h>
 
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 #include <hysteron/run/stepping_method.h>
 
 #include "base/implicit_step.h"

@@ -13,7 +13,7 @@
 #include <deal.II/base/mpi.h>
 
 #include <hysteron/base/rigid_modes.h>
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 
 #include "rbsn/collective.h"
 

@@ -2,7 +2,7 @@
 #include <deal.II/base/exceptions.h>
 
 #include <hysteron/base/exceptions.h>
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include "rbsn/boundary_2d.h"
 #include "rbsn/cgal.h"

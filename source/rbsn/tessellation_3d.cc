@@ -1,6 +1,6 @@
 // The 3D Voronoi tessellation: the Voronoi cells of the nuclei clipped to the polyhedral domain, and their facets.
 #include <hysteron/base/exceptions.h>
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include "rbsn/cgal.h"
 #include "rbsn/polyhedron.h"

@@ -1,7 +1,7 @@
 #ifndef hysteron_source_rbsn_variable_order_h
 #define hysteron_source_rbsn_variable_order_h
 
-#include <hysteron/rbsn/model.h>
+#include "rbsn/model.h"
 #include "base/ida_integrator.h"
 #include "base/sparse_lu.h"
 

@@ -8,7 +8,7 @@
 #include <hysteron/base/parameter_documentation.h>
 #include <hysteron/base/parameters.h>
 #include <hysteron/run/application.h>
-#include <hysteron/run/run_scene.h>
+#include "run/run_scene.h"
 #include <hysteron/scene/scene.h>
 
 #include "run/output_directory.h"

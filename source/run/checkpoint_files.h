@@ -2,7 +2,7 @@
 #define hysteron_source_run_checkpoint_files_h
 
 #include <hysteron/base/checkpoint.h>
-#include <hysteron/base/run_record.h>
+#include "base/run_record.h"
 
 #include <boost/serialization/string.hpp>
 #include <boost/serialization/utility.hpp>

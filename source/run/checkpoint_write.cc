@@ -6,7 +6,7 @@
 
 #include <hysteron/base/checkpoint.h>
 #include <hysteron/base/exceptions.h>
-#include <hysteron/base/run_record.h>
+#include "base/run_record.h"
 
 #include "run/checkpoint_info.h"
 

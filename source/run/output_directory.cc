@@ -4,7 +4,7 @@
 #include <hysteron/base/config.h>
 #include <hysteron/base/exceptions.h>
 #include <hysteron/base/output.h>
-#include <hysteron/base/run_record.h>
+#include "base/run_record.h"
 
 #include "run/output_directory.h"
 

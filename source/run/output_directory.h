@@ -4,7 +4,7 @@
 #include <mpi.h>
 
 #include <hysteron/base/checkpoint.h>
-#include <hysteron/base/run_record.h>
+#include "base/run_record.h"
 
 #include <string>
 

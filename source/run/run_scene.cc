@@ -4,7 +4,7 @@
 #include <hysteron/base/config.h>
 #include <hysteron/base/exceptions.h>
 #include <hysteron/base/output.h>
-#include <hysteron/run/run_scene.h>
+#include "run/run_scene.h"
 
 #include "run/checkpoint_files.h"
 #include "run/output_directory.h"

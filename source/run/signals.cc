@@ -1,6 +1,6 @@
 #include "run/signals.h"
 
-#include <hysteron/base/run_record.h>
+#include "base/run_record.h"
 
 #include <csignal>
 #include <cstdlib>

@@ -3,7 +3,7 @@
 
 #include <mpi.h>
 
-#include <hysteron/base/run_record.h>
+#include "base/run_record.h"
 #include <hysteron/scene/scene.h>
 
 namespace hysteron

@@ -2,8 +2,8 @@
 #include <deal.II/base/timer.h>
 
 #include <hysteron/base/exceptions.h>
-#include <hysteron/base/progress.h>
-#include <hysteron/base/run_record.h>
+#include "base/progress.h"
+#include "base/run_record.h"
 #include <hysteron/run/stepping_method.h>
 #include <hysteron/scene/scene.h>
 #include <hysteron/scene/tables.h>

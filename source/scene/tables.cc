@@ -1,6 +1,6 @@
 #include <deal.II/base/mpi.h>
 
-#include <hysteron/base/plotter.h>
+#include "base/plotter.h"
 #include <hysteron/scene/scene.h>
 #include <hysteron/scene/tables.h>
 

@@ -13,7 +13,7 @@
 #include <hysteron/base/parameters.h>
 #include <hysteron/base/registry.h>
 #include <hysteron/material/interface.h>
-#include <hysteron/run/run_scene.h>
+#include "run/run_scene.h"
 #include <hysteron/scene/scene.h>
 
 #include <gtest/gtest.h>

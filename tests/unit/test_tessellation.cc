@@ -3,7 +3,7 @@
 // first moments add up to the domain's, facets are the common edges).
 #include <hysteron/base/exceptions.h>
 #include <hysteron/geometry/region.h>
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include <gtest/gtest.h>
 

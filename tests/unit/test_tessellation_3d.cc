@@ -5,7 +5,7 @@
 
 #include <hysteron/base/exceptions.h>
 #include <hysteron/geometry/region.h>
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 
 #include "rbsn/polyhedron.h"
 

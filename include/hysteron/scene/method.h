@@ -5,13 +5,17 @@
 
 #include <hysteron/base/checkpoint.h>
 #include <hysteron/base/registry.h>
-#include <hysteron/base/run_record.h>
 
 #include <string>
 #include <vector>
 
 namespace hysteron
 {
+  namespace Output
+  {
+    class RunRecord; // the run's record of its files (opaque to methods)
+  }
+
   template <int dim>
   class Scene;
 

@@ -110,7 +110,7 @@ namespace hysteron
    * (MPM, FEM, RBSN), as named subsections like the materials
    * (see doc/architecture.md).
    *
-   * Run::run_scene() (run/run_scene.h) runs it: set-up, output directory,
+   * Run::run_scene() (source/run/run_scene.h, called by run_application()) runs it: set-up, output directory,
    * the method, the summary and timer table.
    */
   template <int dim>

@@ -1,7 +1,7 @@
 #ifndef hysteron_run_run_scene_h
 #define hysteron_run_run_scene_h
 
-#include <hysteron/base/run_record.h>
+#include "base/run_record.h"
 #include <hysteron/scene/scene.h>
 
 namespace hysteron

@@ -13,7 +13,7 @@
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 
-#include <hysteron/base/direct_solver.h>
+#include "base/direct_solver.h"
 #include <hysteron/base/implicit_dynamics.h>
 #include <hysteron/base/newton.h>
 #include <hysteron/base/output.h>

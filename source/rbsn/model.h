@@ -21,7 +21,7 @@
 #include <hysteron/base/output.h>
 #include <hysteron/rbsn/spring_law.h>
 #include <hysteron/rbsn/springs.h>
-#include <hysteron/rbsn/tessellation.h>
+#include "rbsn/tessellation.h"
 #include <hysteron/scene/method.h>
 #include <hysteron/scene/scene.h>
 #include <hysteron/scene/tables.h>
