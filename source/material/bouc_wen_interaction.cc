@@ -4,12 +4,14 @@
 #include <hysteron/material/integer_power.h>
 
 #include "bouc_wen_kernel_helpers.h"
+#include "material/safeguarded_newton.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
 #include <sstream>
+#include <utility>
 #include <stdexcept>
 
 namespace hysteron
@@ -408,32 +410,14 @@ namespace hysteron
           step *= 2;
         }
 
-      // Safeguarded Newton from hi (G >= 0), bisection where Newton leaves the bracket.
-      double       nu         = hi;
-      unsigned int iterations = 0;
-      while (v.G != 0)
-        {
-          if (++iterations > max_iterations)
-            fail("too many iterations", v.w, d);
-          if (v.G < 0)
-            lo = nu;
-          else
-            hi = nu;
-          double       delta = v.G / v.dG;
-          const double next  = nu - delta;
-          if (!std::isfinite(delta) || (next - lo) * (next - hi) > 0)
-            delta = nu - 0.5 * (lo + hi);
-          nu -= delta;
-          v = evaluate(nu);
-          if (std::isnan(v.G))
-            fail("the residual is not a number", v.w, d);
-          // |r| = |g| |C w| <= |g| Phi: both the step and the residual below the tolerance.
-          const double scale = tolerance * (1 + nu);
-          if (std::abs(delta) <= scale && std::abs(v.G) <= scale && std::isfinite(v.dG))
-            break;
-          if (hi - lo <= 4 * std::numeric_limits<double>::epsilon() * (1 + hi))
-            break; // the bracket has collapsed to round-off
-        }
+      // Safeguarded Newton from hi (G >= 0), bisection where Newton leaves the bracket;
+      // |r| = |g| |C w| <= |g| Phi: both the step and the residual below the tolerance.
+      double             nu         = hi;
+      const unsigned int iterations = safeguarded_newton(
+        nu, lo, v, evaluate, [](const Reduced &r) { return std::make_pair(r.G, r.dG); },
+        [&](const double x) { return tolerance * (1 + x); },
+        [](const double h) { return 4 * std::numeric_limits<double>::epsilon() * (1 + h); }, max_iterations,
+        [&](const char *what, double, const Reduced &r) { fail(what, r.w, d); });
       w = v.w;
 
       if (dw_dd)

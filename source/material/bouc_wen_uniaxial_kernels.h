@@ -8,9 +8,12 @@
 #include <hysteron/material/bogacki_shampine.h>
 #include <hysteron/material/bouc_wen_uniaxial.h>
 
+#include "material/safeguarded_newton.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace hysteron
 {
@@ -266,30 +269,14 @@ namespace hysteron
       // convex and increasing in z, so Newton converges monotonically from there;
       // bisection where Newton would leave the bracket (non-convex unloading
       // branch for beta > gamma, kink at z = 0 for n < 1).
-      double       z          = hi;
-      unsigned int iterations = 0;
-      while (res.r != 0)
-        {
-          if (++iterations > max_iterations)
-            throw_no_convergence(deps, z, res.r, "too many iterations");
-          if (res.r < 0)
-            lo = z;
-          else
-            hi = z;
-          double       step = res.r / res.dr_dz;
-          const double next = z - step;
-          if (!std::isfinite(step) || (next - lo) * (next - hi) > 0)
-            step = z - 0.5 * (lo + hi);
-          z -= step;
-          res = rho(z);
-          if (std::isnan(res.r))
-            throw_no_convergence(deps, z, res.r, "the residual is not a number");
-          if (std::abs(step) <= tolerance * z_y && std::abs(res.r) <= tolerance * z_y &&
-              std::isfinite(res.dr_dz))
-            break;
-          if (std::abs(lo - hi) <= 4 * std::numeric_limits<double>::epsilon() * z_y)
-            break; // the bracket has collapsed to round-off
-        }
+      double             z          = hi;
+      const double       scale      = tolerance * z_y;
+      const double       collapse_width = 4 * std::numeric_limits<double>::epsilon() * z_y;
+      const unsigned int iterations = safeguarded_newton(
+        z, lo, res, [&](const double x) { return rho(x); },
+        [](const auto &r) { return std::make_pair(r.r, r.dr_dz); }, [&](double) { return scale; },
+        [&](double) { return collapse_width; }, max_iterations,
+        [&](const char *what, const double x, const auto &r) { throw_no_convergence(deps, x, r.r, what); });
 
       v[0] = z;
       if constexpr (degrading_)
