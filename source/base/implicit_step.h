@@ -13,6 +13,17 @@
 
 namespace hysteron
 {
+  struct TimeControl;
+
+  /**
+   * The increment control of an implicit method: nominal increments @p nominal, halved at
+   * most @p max_cuts times when Newton fails, and with @p load_steps the nominal
+   * increments of the scene's load steps (`Time/Steps`, each step's length over its
+   * number of increments) instead.
+   */
+  IncrementControl
+  increment_control(double nominal, unsigned int max_cuts, const TimeControl &time, bool load_steps);
+
   /**
    * What one increment from the converged state u to t1 asks of an implicit method whose
    * unknowns are one vector (the FEM's and the RBSN's displacements): the residual r, the

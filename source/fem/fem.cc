@@ -410,13 +410,7 @@ namespace hysteron
         nominal = time.cfl_factor * critical_step;
       else if (nominal == 0)
         nominal = time.end_time / n_increments;
-      increments   = IncrementControl(nominal, newton.max_cuts);
-      if (analysis != Analysis::explicit_dynamics && !time.steps.empty())
-        {
-          std::vector<double> ends, nominals;
-          time.step_grid(ends, nominals);
-          increments.set_steps(ends, nominals);
-        }
+      increments = increment_control(nominal, newton.max_cuts, time, analysis != Analysis::explicit_dynamics);
       step_checked = false;
     }
 

@@ -67,13 +67,7 @@ namespace hysteron
       double      nominal = time_step > 0 ? time_step : time.time_step;
       if (nominal == 0)
         nominal = time.end_time / n_increments;
-      increments = IncrementControl(nominal, newton.max_cuts);
-      if (analysis != Analysis::variable_order && !time.steps.empty())
-        {
-          std::vector<double> ends, nominals;
-          time.step_grid(ends, nominals);
-          increments.set_steps(ends, nominals);
-        }
+      increments = increment_control(nominal, newton.max_cuts, time, analysis != Analysis::variable_order);
     }
 
 
