@@ -44,7 +44,7 @@ namespace hysteron
       // Not the count of factorizations: it counts this process's work (a resumed run
       // factorizes its first matrix anew), not state.
       auto increment_state = increments.state();
-      ar &force_scale &last_force_level &predictor_level &internal_work &external_work &boundary_work &n_steps
+      ar &force_scale &last_force_level &predictor_level &internal_work &external_work &boundary_work &n_ida_steps
         &n_newton &n_broken &n_cuts &increment_state &fracture_energy;
       if constexpr (Archive::is_loading)
         increments.restore(increment_state);
@@ -132,7 +132,7 @@ namespace hysteron
       self.serialize_global(global);
       self.serialize_tangent(rank);
       // A replicated network (every rank holds all of it) is written by rank 0.
-      const MPI_Comm             comm = scene.mpi_communicator();
+      const MPI_Comm             comm = scene().mpi_communicator();
       std::vector<std::uint64_t> keys;
       if (distributed() || dealii::Utilities::MPI::this_mpi_process(comm) == 0)
         keys.assign(cell_id.begin(), cell_id.begin() + n_owned_cells);
@@ -150,7 +150,7 @@ namespace hysteron
     {
       serialize_global(global);
       const std::vector<std::uint64_t> keys(cell_id.begin(), cell_id.begin() + n_owned_cells);
-      Run::load_records(directory.file("cells"), keys, scene.mpi_communicator(),
+      Run::load_records(directory.file("cells"), keys, scene().mpi_communicator(),
                         [&](CheckpointReader &in, const std::size_t c) { serialize_cell(in, c); });
       for (Vector *x : {&u, &u_trial, &v, &a})
         x->update_ghost_values();

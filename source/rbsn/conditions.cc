@@ -32,9 +32,9 @@ namespace hysteron
       const double tolerance = selection_tolerance();
       history_cells.clear();
       history_size.clear();
-      for (const unsigned int k : scene.output_control().history_sets)
+      for (const unsigned int k : scene().output_control().history_sets)
         {
-          const SetDescription<dim> &d = scene.set_descriptions()[k];
+          const SetDescription<dim> &d = scene().set_descriptions()[k];
           std::vector<unsigned int>  cells;
           for (unsigned int c = 0; c < n_owned_cells; ++c)
             {
@@ -62,7 +62,7 @@ namespace hysteron
     Model<dim>::setup_dirichlet()
     {
       using Type                 = typename BoundaryDescription<dim>::Type;
-      const auto        &bodies  = scene.body_descriptions();
+      const auto        &bodies  = scene().body_descriptions();
       const auto        &lo      = nuclei_box[0], &hi = nuclei_box[1];
       const double       tolerance = selection_tolerance();
       const MPI_Comm     comm    = network_communicator();
@@ -71,7 +71,7 @@ namespace hysteron
       dirichlet.clear();
       // A DoF that two conditions select belongs to the first (its reaction); the two must
       // prescribe the same motion there (ConditionOverlaps), else the scene is refused.
-      ConditionOverlaps<dim> overlaps(scene.boundary_descriptions(), scene.time_control().end_time, "cell of the network (its nucleus)");
+      ConditionOverlaps<dim> overlaps(scene().boundary_descriptions(), scene().time_control().end_time, "cell of the network (its nucleus)");
       bool selects_owned = false; // the current condition selects an owned cell
       const auto take = [&](Dirichlet &set, const unsigned int dof) {
         selects_owned = selects_owned || dof < n_dofs * n_owned_cells;
@@ -100,9 +100,9 @@ namespace hysteron
       // The translations by the boundary's rule; the rotations with all of them (fixed,
       // or velocity / displacement of every component: the rigid motion the field gives
       // the nucleus), not for a roller. Every local cell, ghosts included.
-      for (unsigned int b = 0; b < scene.boundary_descriptions().size(); ++b)
+      for (unsigned int b = 0; b < scene().boundary_descriptions().size(); ++b)
         {
-          const auto &d = scene.boundary_descriptions()[b];
+          const auto &d = scene().boundary_descriptions()[b];
           Dirichlet   set;
           set.name      = d.name;
           set.boundary  = b;
@@ -154,10 +154,10 @@ namespace hysteron
     {
       // A total force is shared evenly by the cells whose nucleus is in the region; a
       // traction acts on the boundary pieces of the cells in the region.
-      const auto  &bodies    = scene.body_descriptions();
+      const auto  &bodies    = scene().body_descriptions();
       const double tolerance = selection_tolerance();
       load_sets.clear();
-      const auto &loads = scene.load_descriptions();
+      const auto &loads = scene().load_descriptions();
       for (unsigned int l = 0; l < loads.size(); ++l)
         {
           LoadSet set;
@@ -255,8 +255,8 @@ namespace hysteron
     {
       const unsigned int c = dof / n_dofs, k = dof % n_dofs;
       if (set.rigid >= 0)
-        return k < dim ? scene.body_descriptions()[set.rigid].rigid_displacement(t0, t1)[k] : 0.0;
-      const auto &d = scene.boundary_descriptions()[set.boundary];
+        return k < dim ? scene().body_descriptions()[set.rigid].rigid_displacement(t0, t1)[k] : 0.0;
+      const auto &d = scene().boundary_descriptions()[set.boundary];
       const auto &x = local_nuclei[c];
       if (k < dim && (d.velocity || d.displacement))
         return d.displacement_increment(t0, t1, x)[k];
@@ -290,8 +290,8 @@ namespace hysteron
     {
       const unsigned int k = dof % n_dofs;
       if (set.rigid >= 0)
-        return k < dim ? scene.body_descriptions()[set.rigid].rigid_velocity_at(t)[k] : 0.0;
-      const auto &d = scene.boundary_descriptions()[set.boundary];
+        return k < dim ? scene().body_descriptions()[set.rigid].rigid_velocity_at(t)[k] : 0.0;
+      const auto &d = scene().boundary_descriptions()[set.boundary];
       if (d.velocity)
         return k < dim ? d.velocity_at(t)[k] : 0.0;
       if (!d.displacement || dt <= 0)
@@ -310,7 +310,7 @@ namespace hysteron
       // Loads, and gravity at the centroids (a force and its moment about the nucleus),
       // on the owned cells.
       f                 = 0;
-      const auto &loads = scene.load_descriptions();
+      const auto &loads = scene().load_descriptions();
       const auto  add   = [&](const unsigned int c, const dealii::Tensor<1, dim> &arm, const dealii::Tensor<1, dim> &F) {
         for (unsigned int d = 0; d < dim; ++d)
           f.local_element(n_dofs * c + d) += F[d];
@@ -329,7 +329,7 @@ namespace hysteron
           for (unsigned int k = 0; k < set.cells.size(); ++k)
             add(set.cells[k], set.arm[k], set.weight[k] * value);
         }
-      const dealii::Tensor<1, dim> &g = scene.gravity();
+      const dealii::Tensor<1, dim> &g = scene().gravity();
       if (g.norm() > 0)
         for (unsigned int c = 0; c < n_owned_cells; ++c)
           add(c, cell_offset[c], cell_mass[c] * g);

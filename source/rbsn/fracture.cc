@@ -214,7 +214,7 @@ namespace hysteron
         for (const auto &row : breaks.rows)
           fracture_table->add_row(row);
       breaks.rows.clear();
-      if (scene.is_root())
+      if (scene().is_root())
         for (const auto &m : breaks.messages)
           std::cerr << "hysteron: warning: " << m << std::endl;
       breaks.messages.clear();

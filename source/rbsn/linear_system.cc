@@ -23,7 +23,7 @@ namespace hysteron
       setup_parallel_system();
       // The serial matrix: one part, or rank 0 under the gathered UMFPACK solver.
       const bool gathered = distributed() && linear_solver == "direct" && distributed_solver == "UMFPACK";
-      if (!trilinos_system() || (gathered && scene.is_root()))
+      if (!trilinos_system() || (gathered && scene().is_root()))
         {
           const dof_index                n = n_dofs * n_cells;
           dealii::DynamicSparsityPattern dsp(n, n);
@@ -50,7 +50,7 @@ namespace hysteron
               std::vector<unsigned long long> pairs;
               for (const auto &f : network.facets)
                 pairs.insert(pairs.end(), {cell_block[f.a], cell_block[f.b]});
-              const auto all = Collective::gather(pairs, scene.mpi_communicator(), 0);
+              const auto all = Collective::gather(pairs, scene().mpi_communicator(), 0);
               for (std::size_t k = 0; k < all.size(); k += 2)
                 for (const auto p : {all[k], all[k + 1]})
                   for (const auto q : {all[k], all[k + 1]})
@@ -65,7 +65,7 @@ namespace hysteron
           std::vector<unsigned long long> pairs;
           for (const auto &f : network.facets)
             pairs.insert(pairs.end(), {cell_block[f.a], cell_block[f.b]});
-          Collective::gather(pairs, scene.mpi_communicator(), 0);
+          Collective::gather(pairs, scene().mpi_communicator(), 0);
         }
       factorized = false;
       direct->clear();

@@ -11,15 +11,9 @@ namespace hysteron
   namespace RBSN
   {
     template <int dim>
-    Model<dim>::Model(const Scene<dim> &scene, const Methods::Interface<dim> &method, dealii::ParameterHandler &prm)
-      : scene(scene)
-      , method(method)
-      , direct(std::make_unique<SparseLU>())
-    {
-      scene.refuse_fem_only_sets("rbsn", true);
-      parse_parameters(prm);
-      check_bodies();
-    }
+    Model<dim>::Model()
+      : direct(std::make_unique<SparseLU>())
+    {}
 
 
 
@@ -30,13 +24,13 @@ namespace hysteron
 
     template <int dim>
     std::string
-    Model<dim>::summary(const unsigned long steps, const unsigned int outputs, const bool resumed) const
+    Model<dim>::summary() const
     {
       std::ostringstream s;
       s << n_cells << " cells, " << n_global_facets << " facets, "
-        << (analysis == Analysis::variable_order ? n_steps : steps) << " steps, " << n_newton
+        << (analysis == Analysis::variable_order ? n_ida_steps : this->n_steps()) << " steps, " << n_newton
         << " Newton iterations";
-      s << ", " << n_factorizations << " factorizations" << (resumed ? " since the resume" : "");
+      s << ", " << n_factorizations << " factorizations" << (this->resuming() ? " since the resume" : "");
       if (incremental_assembly && n_facet_evaluations > 0)
         {
           const MPI_Comm      comm    = network_communicator();
@@ -61,7 +55,7 @@ namespace hysteron
           if (fracture_energy > 0)
             s << ", fracture energy " << fracture_energy << " J";
         }
-      s << ", " << outputs << " outputs";
+      s << ", " << this->n_outputs() << " outputs";
       return s.str();
     }
 

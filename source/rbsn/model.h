@@ -21,6 +21,7 @@
 #include <hysteron/base/output.h>
 #include <hysteron/rbsn/spring_law.h>
 #include <hysteron/rbsn/springs.h>
+#include <hysteron/run/stepping_method.h>
 #include "rbsn/tessellation.h"
 #include <hysteron/scene/method.h>
 #include <hysteron/scene/scene.h>
@@ -48,8 +49,17 @@ namespace hysteron
     } // namespace Blocks
 
     /**
-     * The scene on the network (see Solver), in 2D (cells with the DoFs u, v, theta)
-     * or 3D (u_x, u_y, u_z, theta_x, theta_y, theta_z).
+     * The Rigid-Body-Spring Network, the method `rbsn` (`set Method = rbsn`,
+     * dissertation chapter 3; doc/rbsn.md, doc/rbsn3d.md): the scene's bodies are cut
+     * into Voronoi cells around seeded random points; every cell is a rigid body with
+     * the DoFs of its nucleus (2D: u, v, theta; 3D: u_x, u_y, u_z, theta_x, theta_y,
+     * theta_z), and every common facet of two cells carries zero-length springs (2D:
+     * normal, tangential, rotational; 3D: normal, two shear, two bending, torsion) with
+     * the Voronoi scaled stiffnesses of eq. 3.9 and the spring law of `RBSN/Spring law`
+     * (eq. 3.32-3.42). Static, quasi-static (Newton) and dynamic (Newmark / HHT with
+     * Newton, or SUNDIALS' variable-order IDA) analyses, and brittle fracture of the
+     * facets (Mohr-Coulomb with a tension cut-off, eq. 3.49-3.51). The driver
+     * (Run::SteppingMethod) calls the hooks; each is defined in the file of its job.
      *
      * Under MPI the network is distributed. A large network is sampled block by block
      * (blocks.cc), each rank holding the nuclei of its blocks and of those around its
@@ -67,78 +77,96 @@ namespace hysteron
      * upper cells.
      */
     template <int dim>
-    class Model
+    class Model : public Run::SteppingMethod<dim>
     {
     public:
       /// DoFs per cell: 3 (u, v, theta) in 2D, 6 (translations, rotations) in 3D.
       static constexpr unsigned int n_dofs = n_springs<dim>;
 
-      Model(const Scene<dim> &scene, const Methods::Interface<dim> &method, dealii::ParameterHandler &prm);
-      ~Model();
+      Model();
+      ~Model() override;
 
       static void
       declare_parameters(dealii::ParameterHandler &prm);
 
-      // What the driver (Run::SteppingMethod, through Solver) calls.
       /// The network, springs, system and conditions; writes no file.
       void
-      setup();
-      /// The tables (newton.csv or ida.csv, fracture.csv and the point tables).
-      void
-      open_outputs();
-      /// Forces at t = 0, and the initial acceleration in dynamics.
-      void
-      initialize();
-      double
-      propose_step(double t);
-      /// One increment with its fracture cycles (or, with variable order, the whole
-      /// integration, reporting each output time to @p step_finished).
-      bool
-      advance(double &t, double dt, const std::function<void(double)> &step_finished);
-      void
-      write_rows(const double t)
-      {
-        write_table_rows(t);
-      }
-      void
-      write_fields(double t, Output::FieldWriter &writer);
-      /// springs.csv when asked for.
-      void
-      finish();
+      setup() override;
       /// Why this analysis cannot be checkpointed ("" if it can).
       std::string
-      checkpoint_unsupported() const;
-      /// The network's state as records keyed by cell (any number of ranks resumes
-      /// it), the global state in @p global, this rank's assembled tangent in @p rank.
-      void
-      save(CheckpointWriter &global, CheckpointWriter &rank, const CheckpointDirectory &directory) const;
-      void
-      load(CheckpointReader &global, std::vector<CheckpointReader> &rank_parts, const CheckpointDirectory &directory);
+      checkpoint_unsupported() const override;
+      /// The run's summary (the factorizations of a resumed run are this process's).
+      std::string
+      summary() const override;
+
       /// The values of the system matrix (this rank's rows), in the pattern's order.
       std::vector<double>
       matrix_values() const;
       void
       set_matrix_values(const std::vector<double> &values);
 
-      /// The run's summary, with the driver's counts (@p resumed: the factorizations are
-      /// this process's, since the resume).
-      std::string
-      summary(unsigned long steps, unsigned int outputs, bool resumed) const;
-
-      /// The number of cells of the whole network.
-      std::size_t
-      n_global_cells() const
-      {
-        return n_cells;
-      }
-
       /// A network predicted to have at most this many points (the integral of
       /// Spacing::predicted_points) is one sampling block, unless `Sampling block size`
       /// is given: every rank samples it, as before the tiling (doc/rbsn.md).
       static constexpr double single_block_points = dim == 2 ? 2e4 : 1e4;
 
+    protected:
+      // The driver's hooks (Run::SteppingMethod).
+      /// Parse `subsection RBSN` and refuse bodies the network cannot hold (parameters.cc).
+      void
+      parse_parameters(dealii::ParameterHandler &prm) override;
+      std::string
+      label() const override
+      {
+        return "rbsn";
+      }
+      std::string
+      field_name() const override
+      {
+        return "rbsn";
+      }
+      /// u and theta per cell.
+      double
+      size_of_state() const override
+      {
+        return double(n_dofs) * n_cells;
+      }
+      /// The tables (newton.csv or ida.csv, fracture.csv and the point tables).
+      void
+      open_outputs() override;
+      /// Forces at t = 0, and the initial acceleration in dynamics.
+      void
+      initialize() override;
+      double
+      propose_step(double t) override;
+      /// One increment with its fracture cycles (or, with variable order, the whole
+      /// integration, calling step_finished() at each output time).
+      bool
+      advance(double &t, double dt) override;
+      void
+      write_rows(double t) override;
+      void
+      write_fields(double t, Output::FieldWriter &writer) override;
+      /// springs.csv and cells.csv when asked for, the history plots.
+      void
+      finish(double t) override;
+      /// The network's state as records keyed by cell (any number of ranks resumes
+      /// it), the global state in @p global, this rank's assembled tangent in @p rank.
+      void
+      save(CheckpointWriter &global, CheckpointWriter &rank, const CheckpointDirectory &directory) const override;
+      void
+      load(CheckpointReader              &global,
+           std::vector<CheckpointReader> &rank_parts,
+           const CheckpointDirectory     &directory) override;
+
     private:
       using Vector       = dealii::LinearAlgebra::distributed::Vector<double>;
+
+      const Scene<dim> &
+      scene() const
+      {
+        return this->get_scene();
+      }
 
       /// The state the same on every rank (step control, counters, works, tables).
       template <class Archive>
@@ -210,10 +238,7 @@ namespace hysteron
       /// The box of the nuclei, the cells' bodies and the owned cells' mass properties.
       void
       setup_cells();
-      /// Parse `subsection RBSN` (the constructor).
-      void
-      parse_parameters(dealii::ParameterHandler &prm);
-      /// Refuse bodies the network cannot hold; the shapes of the others (the constructor).
+      /// Refuse bodies the network cannot hold; the shapes of the others (parse_parameters()).
       void
       check_bodies();
       /// The springs of the owned facets: stiffnesses, B and the spring law (springs.cc).
@@ -465,15 +490,13 @@ namespace hysteron
       void
       parse_variable_order_parameters(dealii::ParameterHandler &prm);
       /// Integrate from 0 to the end time, reporting the output times k @p output_interval
-      /// to @p step_finished (the driver writes tables and fields there); returns the end time.
+      /// to step_finished() (the driver writes tables and fields there); returns the end time.
       double
-      integrate_variable_order(const double output_interval, const std::function<void(double)> &step_finished);
+      integrate_variable_order(const double output_interval);
 
       // Output.
       std::vector<std::string>
       point_columns() const;
-      void
-      write_table_rows(const double t);
       void
       write_vtu(std::ostream &out) const;
 
@@ -490,9 +513,6 @@ namespace hysteron
       /// The local DoFs of facet @p e's cells (a's, then b's).
       std::array<unsigned int, 2 * n_dofs>
       facet_local_dofs(const unsigned int e) const;
-
-      const Scene<dim>              &scene;
-      const Methods::Interface<dim> &method;
 
       // Parameters.
       Spacing<dim>                    spacing; ///< `Minimum distance` d(x), sampled by build_network()
@@ -602,7 +622,7 @@ namespace hysteron
       IncrementControl increments{1.0, 0};
       double internal_work = 0, external_work = 0, boundary_work = 0;
       double fracture_energy = 0; ///< released by breaks in static steps (in internal_work)
-      unsigned long n_steps = 0; ///< variable order: IDA's steps
+      unsigned long n_ida_steps = 0; ///< variable order: IDA's steps
       unsigned long n_newton = 0, n_broken = 0;
       unsigned int  n_cuts = 0;
       std::string   spring_failure;

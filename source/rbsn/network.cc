@@ -63,7 +63,7 @@ namespace hysteron
             if constexpr (dim == 2)
               p = boundary_points(*body_shapes[s], spacing, boundary_h);
             else
-              p = boundary_points(*body_shapes[s], spacing, boundary_h, scene.random_seed() + 104729 * s);
+              p = boundary_points(*body_shapes[s], spacing, boundary_h, scene().random_seed() + 104729 * s);
             fixed.insert(fixed.end(), p.begin(), p.end());
           }
       std::vector<dealii::Point<dim>> points;
@@ -151,11 +151,11 @@ namespace hysteron
         // slopes of the peak RSS, rounded up: 6.1 kB per cell in 2D (2.7e4 ... 5.6e4 cells),
         // 46 kB in 3D (7.7e3 ... 1.6e4 cells), linear static, CG + ML, measured by
         //   benchmarks/memory_estimate.py --hysteron build/hysteron --only rbsn
-        // (each run /usr/bin/time -v hysteron scene.prm); the fill from the UMFPACK and CG
+        // (each run /usr/bin/time -v hysteron scene().prm); the fill from the UMFPACK and CG
         // runs of doc/benchmarks.md (2D 13.9 against 7.4 kB per cell at 1e5 cells; 3D 203 kB
         // per cell at 2.1e4 cells, 117 kB at 3.8e3: 6 kB n^(1/3) over CG's 48 kB).
         constexpr double   bytes_per_cell[2] = {6.5e3, 48e3};
-        const MPI_Comm     comm              = scene.mpi_communicator();
+        const MPI_Comm     comm              = scene().mpi_communicator();
         const unsigned int n_ranks           = dealii::Utilities::MPI::n_mpi_processes(comm);
         const double       n                 = spacing.predicted_points;
         const bool         whole             = analysis == Analysis::variable_order || n_ranks == 1;
@@ -180,9 +180,9 @@ namespace hysteron
                                std::string(linear_solver == "direct" ? ", RBSN/Linear solver = cg or gmres" : "") +
                                " or more machines");
       }
-      StageReport stage(scene.console(), spacing.predicted_points > (dim == 2 ? 5e4 : 1e4));
+      StageReport stage(scene().console(), spacing.predicted_points > (dim == 2 ? 5e4 : 1e4));
       if (stage.enabled())
-        scene.console() << "rbsn: about " << StageReport::count(static_cast<std::size_t>(spacing.predicted_points))
+        scene().console() << "rbsn: about " << StageReport::count(static_cast<std::size_t>(spacing.predicted_points))
                         << " cells predicted (" << integral << ", " << distance << " m)" << std::endl;
 
       // The nuclei: the user's points, points along every body's boundary, then random
@@ -200,7 +200,7 @@ namespace hysteron
               hi[d] = s == 0 ? boxes[s].second[d] : std::max(hi[d], boxes[s].second[d]);
             }
         }
-      const MPI_Comm                comm    = scene.mpi_communicator();
+      const MPI_Comm                comm    = scene().mpi_communicator();
       const unsigned int            n_ranks = dealii::Utilities::MPI::n_mpi_processes(comm);
       const Blocks::Layout<dim>     layout(lo, hi, sampling_block_side(), boxes);
       Blocks::Nuclei<dim>           nuclei(layout, comm);
@@ -248,10 +248,10 @@ namespace hysteron
         {
           std::vector<dealii::Point<dim>> filled;
           if constexpr (dim == 2)
-            filled = poisson_disk_points(*body_shapes[s], spacing, points, scene.random_seed() + 7919 * s,
+            filled = poisson_disk_points(*body_shapes[s], spacing, points, scene().random_seed() + 7919 * s,
                                          "RBSN/Minimum distance");
           else
-            filled = poisson_disk_points(*body_shapes[s], spacing, points, scene.random_seed() + 7919 * s,
+            filled = poisson_disk_points(*body_shapes[s], spacing, points, scene().random_seed() + 7919 * s,
                                          "RBSN/Minimum distance", boundary_h);
           points.swap(filled);
         }
@@ -266,7 +266,7 @@ namespace hysteron
                               const Blocks::Layout<dim>             &layout,
                               Blocks::Nuclei<dim>                   &nuclei) const
     {
-      const MPI_Comm comm = scene.mpi_communicator();
+      const MPI_Comm comm = scene().mpi_communicator();
       require(analysis != Analysis::variable_order || dealii::Utilities::MPI::n_mpi_processes(comm) == 1,
               "RBSN/Analysis",
               "the variable-order analysis integrates the whole network as one SUNDIALS vector on "
@@ -289,7 +289,7 @@ namespace hysteron
           sources.bodies.push_back(samplers[s].get());
           sources.body_boxes.push_back(body_shapes[s]->bounding_box().get_boundary_points());
         }
-      sources.seed   = scene.random_seed();
+      sources.seed   = scene().random_seed();
       sources.margin = 2 * spacing.max;
       const std::vector<double> predicted = spacing.predicted_in_blocks(layout.origin, layout.side, layout.n);
       for (unsigned int b = 0; b < layout.size(); ++b)
@@ -326,7 +326,7 @@ namespace hysteron
       // The nuclei within H of an owned one, the owned ones flagged; their cells are
       // exact if 2 reach <= H (see the top of the file). A rank whose halo is too narrow
       // doubles it; the others wait for it in the fetches.
-      const MPI_Comm comm = scene.mpi_communicator();
+      const MPI_Comm comm = scene().mpi_communicator();
       nuclei.partition(n_parts);
       double                     H    = 2.5 * spacing.max;
       bool                       done = false;
@@ -434,7 +434,7 @@ namespace hysteron
       // The box of the nuclei (the faces that select cells), the bodies of the local
       // cells, and the rigid-body mass properties of the owned ones about their nuclei
       // (eq. 3.12; in 3D the inertia tensor).
-      const auto &bodies = scene.body_descriptions();
+      const auto &bodies = scene().body_descriptions();
       nuclei_box.assign(2, local_nuclei[0]);
       for (unsigned int c = 0; c < n_owned_cells; ++c)
         for (unsigned int d = 0; d < dim; ++d)
@@ -479,7 +479,7 @@ namespace hysteron
         {
           const auto  &cell = network.cells[c];
           const auto  &body = bodies[cell_body[c]];
-          const double rho  = scene.material(body.material, "Body " + body.name + "/Material").density();
+          const double rho  = scene().material(body.material, "Body " + body.name + "/Material").density();
           cell_offset[c]    = cell.centroid - cell.nucleus;
           if constexpr (dim == 2)
             {

@@ -113,7 +113,7 @@ namespace hysteron
       probe_global_facet.clear();
       probe_cell.clear();
       probe_facet.clear();
-      for (const auto &p : scene.output_control().probe_points)
+      for (const auto &p : scene().output_control().probe_points)
         {
           // A probe outside every body would silently report its nearest cell.
           const double tolerance = 1e-6 * d_m;
@@ -167,19 +167,19 @@ namespace hysteron
     void
     Model<dim>::open_tables()
     {
-      tables.open(scene, method.output_directory(), point_columns(), method.run_record());
-      if (!scene.is_root())
+      tables.open(scene(), this->output_directory(), point_columns(), this->run_record());
+      if (!scene().is_root())
         return;
       if (analysis == Analysis::variable_order)
         newton_table = std::make_unique<Output::TimeTable>(
-          method.output_file("ida.csv"),
+          this->output_file("ida.csv"),
           std::vector<std::string>{"time", "steps", "order", "step", "residuals", "jacobians",
                                    "nonlinear_iterations", "error_test_failures",
                                    "convergence_failures"},
-          method.run_record());
+          this->run_record());
       else if (analysis != Analysis::linear_static)
         newton_table =
-          std::make_unique<Output::TimeTable>(method.output_file("newton.csv"), newton_columns(), method.run_record());
+          std::make_unique<Output::TimeTable>(this->output_file("newton.csv"), newton_columns(), this->run_record());
       if (fracture.enabled)
         {
           std::vector<std::string> columns{"time", "facet", "x", "y"};
@@ -190,7 +190,7 @@ namespace hysteron
             columns.push_back("separated_z");
           columns.push_back("released_cells");
           fracture_table =
-            std::make_unique<Output::TimeTable>(method.output_file("fracture.csv"), columns, method.run_record());
+            std::make_unique<Output::TimeTable>(this->output_file("fracture.csv"), columns, this->run_record());
         }
     }
 
@@ -198,11 +198,11 @@ namespace hysteron
 
     template <int dim>
     void
-    Model<dim>::write_table_rows(const double t)
+    Model<dim>::write_rows(const double t)
     {
       const MPI_Comm      comm     = network_communicator();
       const unsigned int  n_values = point_columns().size();
-      const auto         &probes   = scene.output_control().probe_points;
+      const auto         &probes   = scene().output_control().probe_points;
       // Each value from the rank that owns its cell or facet (zeros elsewhere): the
       // tables sum the ranks' rows.
       std::vector<double> rows(probes.size() * n_values);
@@ -211,7 +211,7 @@ namespace hysteron
 
       // Averages: cell columns mass-weighted over the cells whose nucleus is in the
       // region; facet columns the mean over the facets whose midpoint is in it.
-      const auto         &regions = scene.output_control().average_regions;
+      const auto         &regions = scene().output_control().average_regions;
       std::vector<double> averages(regions.size() * (1 + n_values), 0.0), values(n_values);
       std::vector<double> totals(2 * regions.size(), 0.0); // mass and facets of each region
       std::vector<std::vector<unsigned int>> inside(regions.size());
@@ -284,7 +284,7 @@ namespace hysteron
                 strain_energy += spring_law->strain_energy(e, i, sp.delta[i], sp.state.data());
             }
       // The works are the network's sums: each rank's share of the row's sum.
-      const double share = distributed() && !scene.is_root() ? 0.0 : 1.0;
+      const double share = distributed() && !scene().is_root() ? 0.0 : 1.0;
 
       // The reactions f_int + inertia - f_ext of the converged state (reaction_old, set by
       // commit()): f_int and inertia hold the last evaluation, a failed iterate when the
@@ -377,12 +377,12 @@ namespace hysteron
         }
       const unsigned int width = columns.size() + 1;
       const std::vector<double> all = distributed() ? Collective::gather(rows, network_communicator(), 0) : rows;
-      if (!scene.is_root())
+      if (!scene().is_root())
         return;
       std::vector<std::vector<double>> ordered(n_global_facets);
       for (std::size_t k = 0; k + width <= all.size(); k += width)
         ordered[static_cast<std::size_t>(all[k])].assign(all.begin() + k + 1, all.begin() + k + width);
-      Output::CsvWriter out(method.output_file("springs.csv"), columns, &method.run_record());
+      Output::CsvWriter out(this->output_file("springs.csv"), columns, &this->run_record());
       for (const auto &row : ordered)
         out.add_row(row);
       out.commit();
@@ -415,12 +415,12 @@ namespace hysteron
             rows.push_back(u.local_element(n_dofs * c + k));
         }
       const std::vector<double> all = distributed() ? Collective::gather(rows, network_communicator(), 0) : rows;
-      if (!scene.is_root())
+      if (!scene().is_root())
         return;
       std::vector<std::vector<double>> ordered(n_cells);
       for (std::size_t k = 0; k + columns.size() <= all.size(); k += columns.size())
         ordered[static_cast<std::size_t>(all[k])].assign(all.begin() + k, all.begin() + k + columns.size());
-      Output::CsvWriter out(method.output_file("cells.csv"), columns, &method.run_record());
+      Output::CsvWriter out(this->output_file("cells.csv"), columns, &this->run_record());
       for (const auto &row : ordered)
         out.add_row(row);
       out.commit();

@@ -37,7 +37,7 @@ namespace hysteron
     MPI_Comm
     Model<dim>::network_communicator() const
     {
-      return distributed() ? scene.mpi_communicator() : MPI_COMM_SELF;
+      return distributed() ? scene().mpi_communicator() : MPI_COMM_SELF;
     }
 
 
@@ -83,7 +83,7 @@ namespace hysteron
         dealii::SparsityTools::distribute_sparsity_pattern(dsp, owned_dofs, comm, relevant_dofs);
       parallel_matrix.reinit(owned_dofs, owned_dofs, dsp, comm);
       if (distributed())
-        scene.console() << "rbsn: " << n_parts << " MPI ranks, " << network.facets.size() << " of "
+        scene().console() << "rbsn: " << n_parts << " MPI ranks, " << network.facets.size() << " of "
                         << n_global_facets << " facets and " << n_owned_cells << " of " << n_cells
                         << " cells on rank 0" << std::endl;
     }

@@ -231,6 +231,12 @@ namespace hysteron
     void
     Model<dim>::parse_parameters(dealii::ParameterHandler &prm)
     {
+      // The network's tables have cell and facet columns, not continuum points.
+      require(scene().output_control().additional_columns.empty(),
+              "Output/Additional columns",
+              "the rbsn method's probe tables hold cell and facet values; additional point "
+              "columns apply to the mpm and fem methods");
+      scene().refuse_fem_only_sets("rbsn", true);
       {
         Section s(prm, {"RBSN"});
         // A number is a constant d_m; anything else an expression in x, y (and z),
@@ -297,6 +303,7 @@ namespace hysteron
           }
       }
       parse_variable_order_parameters(prm);
+      check_bodies();
     }
 
 
@@ -305,7 +312,7 @@ namespace hysteron
     void
     Model<dim>::check_bodies()
     {
-      const auto &bodies = scene.body_descriptions();
+      const auto &bodies = scene().body_descriptions();
       require(!bodies.empty(), "Body names", "the rbsn method needs at least one body");
       for (unsigned int b = 0; b < bodies.size(); ++b)
         if (!bodies[b].rigid)
@@ -320,7 +327,7 @@ namespace hysteron
                         "bodies (its cells are clipped to them)");
             body_shapes.push_back(&bodies[b].shape);
             mesh_body.push_back(b);
-            const auto &m = scene.material(bodies[b].material, "Body " + bodies[b].name + "/Material");
+            const auto &m = scene().material(bodies[b].material, "Body " + bodies[b].name + "/Material");
             if constexpr (dim == 2)
               {
                 require(m.elasticity().stress_state != Material::StressState::three_dimensional,
@@ -349,7 +356,7 @@ namespace hysteron
                     "only dynamic analyses have velocities");
           }
       require(!body_shapes.empty(), "Body names", "the rbsn method needs a body that is not rigid");
-      for (const auto &b : scene.boundary_descriptions())
+      for (const auto &b : scene().boundary_descriptions())
         require(b.type != BoundaryDescription<dim>::Type::wall,
                 "Boundary " + b.name + "/Type",
                 "the rbsn method has no walls (use fixed, roller, velocity or displacement)");

@@ -44,7 +44,7 @@ namespace hysteron
     void
     Model<dim>::setup_springs()
     {
-      const auto &bodies = scene.body_descriptions();
+      const auto &bodies = scene().body_descriptions();
       springs.assign(network.facets.size(), Springs<dim>());
       std::string out_of_range, where; // the first facet whose springs overflow
       for (unsigned int e = 0; e < network.facets.size() && out_of_range.empty(); ++e)
@@ -52,8 +52,8 @@ namespace hysteron
           const Facet<dim> &f  = network.facets[e];
           Springs<dim>     &sp = springs[e];
           const auto       &ba = bodies[cell_body[f.a]], &bb = bodies[cell_body[f.b]];
-          const auto       &ma = scene.material(ba.material, "Body " + ba.name + "/Material");
-          const auto       &mb = scene.material(bb.material, "Body " + bb.name + "/Material");
+          const auto       &ma = scene().material(ba.material, "Body " + ba.name + "/Material");
+          const auto       &mb = scene().material(bb.material, "Body " + bb.name + "/Material");
           FacetSprings<dim> facet;
           facet.moment_yield_factor = moment_yield;
           spring_geometry(f, ba, bb, ma, mb, sp, facet);
@@ -90,7 +90,7 @@ namespace hysteron
           sp.trial_state = sp.state;
         }
       // Every rank refuses, with the first rank's facet.
-      const auto found = dealii::Utilities::MPI::all_gather(scene.mpi_communicator(), std::make_pair(where, out_of_range));
+      const auto found = dealii::Utilities::MPI::all_gather(scene().mpi_communicator(), std::make_pair(where, out_of_range));
       for (const auto &[place, problem] : found)
         if (!problem.empty())
           throw InputError(place, problem);

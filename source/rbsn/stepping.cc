@@ -26,7 +26,7 @@ namespace hysteron
     {
       // A large network reports each stage (build_network(): nuclei and cells).
       build_network();
-      StageReport stage(scene.console(), spacing.predicted_points > (dim == 2 ? 5e4 : 1e4));
+      StageReport stage(scene().console(), spacing.predicted_points > (dim == 2 ? 5e4 : 1e4));
       setup_springs();
       stage(StageReport::count(n_global_facets) + " facets' springs");
       setup_system();
@@ -41,29 +41,29 @@ namespace hysteron
           // The set-up's peak resident memory of the ranks (VmHWM), the least and the most.
           dealii::Utilities::System::MemoryStats memory;
           dealii::Utilities::System::get_memory_stats(memory);
-          const MPI_Comm     comm = scene.mpi_communicator();
+          const MPI_Comm     comm = scene().mpi_communicator();
           const double       mb   = memory.VmHWM / 1024.0;
           std::ostringstream line;
           line << std::fixed << std::setprecision(0) << "rbsn: set-up peak memory per rank "
                << dealii::Utilities::MPI::min(mb, comm) << " ... " << dealii::Utilities::MPI::max(mb, comm) << " MB";
-          scene.console() << line.str() << std::endl;
+          scene().console() << line.str() << std::endl;
         }
-      scene.console() << "rbsn: " << n_cells << " cells, " << n_global_facets << " facets (";
+      scene().console() << "rbsn: " << n_cells << " cells, " << n_global_facets << " facets (";
       if (spacing.is_constant())
-        scene.console() << "d_m = " << d_m;
+        scene().console() << "d_m = " << d_m;
       else
-        scene.console() << "d = " << spacing.min << " ... " << spacing.max;
-      scene.console() << " m";
+        scene().console() << "d = " << spacing.min << " ... " << spacing.max;
+      scene().console() << " m";
       if (n_blocks > 1)
-        scene.console() << ", sampled in " << n_blocks << " blocks";
-      scene.console() << "), " << n_dofs * n_cells << " DoFs" << std::endl;
+        scene().console() << ", sampled in " << n_blocks << " blocks";
+      scene().console() << "), " << n_dofs * n_cells << " DoFs" << std::endl;
       if ((analysis == Analysis::quasi_static || analysis == Analysis::implicit_dynamics) &&
-          !consistent_tangent && scene.is_root())
+          !consistent_tangent && scene().is_root())
         std::cerr << "hysteron: warning: RBSN: the springs' tangent is not the algorithmic one "
                      "(Bouc-Wen: Integrator = adaptive or forward euler), so Newton converges "
                      "linearly; Integrator = backward euler gives quadratic convergence"
                   << std::endl;
-      const auto &time    = scene.time_control();
+      const auto &time    = scene().time_control();
       double      nominal = time_step > 0 ? time_step : time.time_step;
       if (nominal == 0)
         nominal = time.end_time / n_increments;
@@ -105,7 +105,7 @@ namespace hysteron
       // Velocities of the nuclei from the bodies' initial velocity (the cells
       // translate; prescribed DoFs move with their conditions), and M a0 = f_ext(0)
       // - f_int(0) - C v0 on the free DoFs.
-      const auto        &bodies  = scene.body_descriptions();
+      const auto        &bodies  = scene().body_descriptions();
       const unsigned int n_owned = u.locally_owned_size();
       for (unsigned int c = 0; c < n_owned_cells; ++c)
         {
@@ -117,7 +117,7 @@ namespace hysteron
       // mean velocity of the first step): with v = 0 under a moving condition the Newmark
       // recursion a1 = 4 (du - dt v0) / dt^2 - a0 on that DoF alternates with a growing
       // amplitude, and its inertia enters the reaction.
-      const double first_step = increments.step(0, scene.time_control().end_time);
+      const double first_step = increments.step(0, scene().time_control().end_time);
       for (unsigned int i = 0; i < n_owned; ++i)
         if (dof_set[i] >= 0)
           v.local_element(i) = prescribed_velocity(dirichlet[dof_set[i]], i, 0, first_step);
@@ -176,7 +176,7 @@ namespace hysteron
       solve_linear(a);
       constraints.distribute(a);
       // ... and its acceleration, g''(0) by a difference of the velocities.
-      const double h = 1e-4 * scene.time_control().end_time;
+      const double h = 1e-4 * scene().time_control().end_time;
       for (unsigned int i = 0; i < n_owned; ++i)
         if (dof_set[i] >= 0)
           a.local_element(i) = (prescribed_velocity(dirichlet[dof_set[i]], i, h, first_step) - v.local_element(i)) / h;
@@ -202,7 +202,7 @@ namespace hysteron
     double
     Model<dim>::propose_step(const double t)
     {
-      const double end_time = scene.time_control().end_time;
+      const double end_time = scene().time_control().end_time;
       if (analysis == Analysis::variable_order)
         return end_time - t;
       return increments.step(t, end_time);
@@ -212,12 +212,12 @@ namespace hysteron
 
     template <int dim>
     bool
-    Model<dim>::advance(double &t, const double dt, const std::function<void(double)> &step_finished)
+    Model<dim>::advance(double &t, const double dt)
     {
       if (analysis == Analysis::variable_order)
         {
           // IDA chooses its steps; the driver's work follows each output time.
-          t = integrate_variable_order(increments.nominal(), step_finished);
+          t = integrate_variable_order(increments.nominal());
           return false;
         }
       // The facets broken since the converged state t in this attempt of the increment
@@ -415,7 +415,7 @@ namespace hysteron
 
     template <int dim>
     void
-    Model<dim>::finish()
+    Model<dim>::finish(const double)
     {
       if (spring_table)
         write_spring_table();

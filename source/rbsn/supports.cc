@@ -163,7 +163,7 @@ namespace hysteron
       std::vector<unsigned long> sizes;
       const auto                 free = network_parts(false, part_of, sizes);
 
-      const auto &bodies = scene.body_descriptions();
+      const auto &bodies = scene().body_descriptions();
       for (unsigned int p = 0; p < free.size(); ++p)
         {
           if (free[p].empty())

@@ -74,11 +74,10 @@ namespace hysteron
 
     template <int dim>
     double
-    Model<dim>::integrate_variable_order(const double                       output_interval,
-                                         const std::function<void(double)> &step_finished)
+    Model<dim>::integrate_variable_order(const double output_interval)
     {
       const auto  &p        = variable_order;
-      const double end_time = scene.time_control().end_time;
+      const double end_time = scene().time_control().end_time;
       VariableOrder dae(*this);
       dealii::Vector<double> y, yp;
       dae.initial_values(y, yp);
@@ -115,7 +114,7 @@ namespace hysteron
           const bool   reached  = ida.advance(t_out, t);
           const double expected = std::min(k * output_interval, end_time);
           const auto   stats    = ida.statistics();
-          n_steps               = stats.steps;
+          n_ida_steps           = stats.steps;
           n_newton              = stats.newton_iterations;
           if (!reached || std::abs(t - expected) > eps)
             {
@@ -138,7 +137,7 @@ namespace hysteron
                                    double(stats.residuals), double(stats.jacobians),
                                    double(stats.newton_iterations), double(stats.error_test_failures),
                                    double(stats.convergence_failures)});
-          step_finished(expected);
+          this->step_finished(expected);
         }
       return end_time;
     }

@@ -98,8 +98,8 @@ namespace hysteron
       const auto  &p     = m.variable_order;
       const double atol  = p.absolute_tolerance > 0 ? p.absolute_tolerance : p.relative_tolerance * 1e-3 * m.scale;
       const double t_out = m.time_step > 0 ? m.time_step :
-                           m.scene.time_control().time_step > 0 ? m.scene.time_control().time_step :
-                                                                  m.scene.time_control().end_time / m.n_increments;
+                           m.scene().time_control().time_step > 0 ? m.scene().time_control().time_step :
+                                                                  m.scene().time_control().end_time / m.n_increments;
       tolerances.assign(n_total, 0.0);
       for (unsigned int i = 0; i < n; ++i)
         {
@@ -152,7 +152,7 @@ namespace hysteron
       // IDA takes no steps of the model's: a prescribed displacement's rate is the mean
       // velocity of a step of 1e-8 of the end time from t (truncation and round-off of
       // about that order).
-      const double h = 1e-8 * std::max(m.scene.time_control().end_time, 1e-300);
+      const double h = 1e-8 * std::max(m.scene().time_control().end_time, 1e-300);
       for (unsigned int i = 0; i < n; ++i)
         w[i] = m.dof_set[i] >= 0 ? m.prescribed_velocity(m.dirichlet[m.dof_set[i]], i, t, h) : 0.0;
     }
