@@ -22,7 +22,6 @@ namespace hysteron
   {
     solver.reset();
     problem.reset();
-    analysed = nullptr;
   }
 
 
@@ -34,9 +33,8 @@ namespace hysteron
   {
     // Amesos takes non-const pointers; it reads the matrix and the right-hand side only.
     auto *A = const_cast<Epetra_CrsMatrix *>(&matrix.trilinos_matrix());
-    if (analysed != &matrix)
+    if (!solver)
       {
-        clear();
         problem = std::make_unique<Epetra_LinearProblem>();
         problem->SetOperator(A);
         Amesos factory;
@@ -44,9 +42,12 @@ namespace hysteron
         if (!solver)
           throw RuntimeError("the direct solver package " + package + " is not available in this Trilinos");
         if (solver->SymbolicFactorization() != 0)
-          throw RuntimeError(package + ": the symbolic factorization failed");
-        analysed = &matrix;
+          {
+            clear();
+            throw RuntimeError(package + ": the symbolic factorization failed");
+          }
       }
+    Assert(problem->GetOperator() == A, dealii::ExcMessage("the matrix was reinit()ed without clear()"));
     problem->SetLHS(&x.trilinos_vector());
     problem->SetRHS(const_cast<Epetra_MultiVector *>(
       static_cast<const Epetra_MultiVector *>(&b.trilinos_vector())));

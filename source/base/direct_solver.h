@@ -14,9 +14,11 @@ namespace hysteron
 {
   /**
    * A Trilinos Amesos direct solver (KLU or MUMPS) of one matrix whose sparsity pattern stays
-   * fixed: the symbolic analysis (ordering, elimination tree) is done at the first solve and
-   * kept, each solve with new values repeats only the numeric factorization. The matrix
-   * object must outlive the solver and keep its pattern (set its values, not reinit() it).
+   * fixed: the symbolic analysis (ordering, elimination tree) is done at the first solve (after
+   * construction or clear()) and kept, each further solve repeats only the numeric
+   * factorization of the matrix's new values. After a reinit() of the matrix (a new pattern or
+   * a new Epetra matrix), call clear(). (deal.II 9.4's TrilinosWrappers::SolverDirect analyses
+   * at every initialize(); see doc/architecture.md.)
    */
   class KeptDirectSolver
   {
@@ -25,20 +27,19 @@ namespace hysteron
     explicit KeptDirectSolver(const std::string &package);
     ~KeptDirectSolver();
 
-    /// Factorize the current values of @p matrix (the same object as before) and solve
-    /// matrix x = b.
+    /// Factorize the current values of @p matrix (the one analysed since the last clear(), or
+    /// analyse it) and solve matrix x = b.
     void
     solve(const dealii::TrilinosWrappers::SparseMatrix &matrix,
           dealii::TrilinosWrappers::MPI::Vector        &x,
           const dealii::TrilinosWrappers::MPI::Vector  &b);
 
-    /// Forget the analysis (the next solve analyses the pattern again).
+    /// Forget the analysis: the matrix was reinit()ed (the next solve analyses it).
     void
     clear();
 
   private:
     std::string                           package;
-    const void                           *analysed = nullptr; ///< the matrix of the analysis
     std::unique_ptr<Epetra_LinearProblem> problem;
     std::unique_ptr<Amesos_BaseSolver>    solver;
   };

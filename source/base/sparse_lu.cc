@@ -11,8 +11,7 @@ namespace hysteron
 {
   struct SparseLU::Data
   {
-    const dealii::SparsityPattern *pattern = nullptr;
-    std::size_t                    n_nonzero = 0;
+    std::size_t n_nonzero = 0; ///< of the analysed pattern (0: none)
     // A^T in compressed columns: the rows of A, each sorted by column.
     std::vector<SuiteSparse_long> starts, indices;
     std::vector<double>           values;
@@ -56,7 +55,6 @@ namespace hysteron
   SparseLU::clear()
   {
     data->release();
-    data->pattern   = nullptr;
     data->n_nonzero = 0;
   }
 
@@ -68,11 +66,9 @@ namespace hysteron
     Data                          &d       = *data;
     const dealii::SparsityPattern &pattern = matrix.get_sparsity_pattern();
     const SuiteSparse_long         n       = matrix.m();
-    if (d.pattern != &pattern || d.n_nonzero != pattern.n_nonzero_elements())
+    if (d.n_nonzero == 0)
       {
         // A new pattern: the sorted layout and the symbolic analysis.
-        d.release();
-        d.pattern   = &pattern;
         d.n_nonzero = pattern.n_nonzero_elements();
         d.starts.assign(n + 1, 0);
         d.indices.resize(d.n_nonzero);
@@ -102,6 +98,8 @@ namespace hysteron
           }
         d.starts[n] = k;
       }
+    AssertThrow(d.n_nonzero == pattern.n_nonzero_elements() && d.starts.size() == std::size_t(n) + 1,
+                dealii::ExcMessage("a matrix of another pattern: call SparseLU::clear() first"));
     // The values in the sorted layout (deal.II's values are stored in pattern order).
     {
       std::size_t k = 0;

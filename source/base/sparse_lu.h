@@ -12,8 +12,10 @@ namespace hysteron
   /**
    * Sparse LU factors of a deal.II SparseMatrix by UMFPACK, for a sequence of
    * matrices with one sparsity pattern (Newton's tangents): the fill-reducing
-   * ordering and symbolic analysis are computed for the first matrix and kept,
-   * so that each further matrix costs only its numeric factorization.
+   * ordering and symbolic analysis are computed for the first matrix (after
+   * construction or clear()) and kept, so that each further matrix costs only
+   * its numeric factorization. A new pattern needs clear() first. (deal.II 9.4's
+   * SparseDirectUMFPACK analyses at every factorize(); see doc/architecture.md.)
    *
    * The matrix's rows are handed to UMFPACK as the columns of A^T (deal.II
    * stores rows with the diagonal first, so a permutation sorts each row once),
@@ -25,8 +27,8 @@ namespace hysteron
     SparseLU();
     ~SparseLU();
 
-    /// Factorize @p matrix (the symbolic analysis is redone only for a new pattern).
-    /// Throws std::runtime_error for a singular matrix.
+    /// Factorize @p matrix (with the pattern analysed since the last clear(), or analyse
+    /// it). Throws std::runtime_error for a singular matrix.
     void
     factorize(const dealii::SparseMatrix<double> &matrix);
 
@@ -35,7 +37,7 @@ namespace hysteron
     void
     solve(dealii::Vector<double> &x, const dealii::Vector<double> &b) const;
 
-    /// Forget the factors and the analysis.
+    /// Forget the factors and the analysis (before a matrix of another pattern).
     void
     clear();
 

@@ -345,6 +345,7 @@ namespace hysteron
           DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
           SparsityTools::distribute_sparsity_pattern(dsp, owned_dofs, comm, relevant_dofs);
           system_matrix.reinit(owned_dofs, owned_dofs, dsp, comm);
+          direct_solver.reset(); // a new pattern: a new analysis
           system_rhs.reinit(owned_dofs, comm);
         }
     }

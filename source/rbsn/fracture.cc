@@ -148,8 +148,7 @@ namespace hysteron
         }
       if (distributed())
         {
-          const int ierr = MPI_Bcast(facet.data(), facet.size(), MPI_DOUBLE, broken.owner, comm);
-          AssertThrowMPI(ierr);
+          dealii::Utilities::MPI::broadcast(facet.data(), facet.size(), broken.owner, comm);
         }
       ++n_broken;
       ++breaks.n;

@@ -104,8 +104,7 @@ namespace hysteron
                   for (int k = 0; k < std::min(n_a, n_f); ++k)
                     add(a[k], f[k]);
                 }
-              const int ierr = MPI_Allreduce(MPI_IN_PLACE, sums, 2, MPI_DOUBLE, MPI_SUM, network_communicator());
-              AssertThrowMPI(ierr);
+              dealii::Utilities::MPI::sum(sums, network_communicator(), sums);
             }
           else
             for (auto p = matrix.begin(), q = factored_matrix.begin(); p != matrix.end(); ++p, ++q)

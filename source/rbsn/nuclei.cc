@@ -143,7 +143,7 @@ namespace hysteron
           if (sampler[b] == rank)
             count[b] = points[b].size();
         if (n_ranks > 1)
-          Collective::all_reduce(count, MPI_SUM, comm);
+          dealii::Utilities::MPI::sum(count, comm, count);
         first.assign(n_blocks + 1, 0);
         std::partial_sum(count.begin(), count.end(), first.begin() + 1);
       }
@@ -204,7 +204,7 @@ namespace hysteron
               for (unsigned int d = 0; d < dim; ++d)
                 message.push_back(p[d]);
           }
-        for (const auto &[from, message] : Collective::exchange(out, comm))
+        for (const auto &[from, message] : dealii::Utilities::MPI::some_to_some(comm, out))
           for (std::size_t k = 0; k < message.size();)
             {
               const unsigned int b = static_cast<unsigned int>(message[k]);
@@ -325,7 +325,7 @@ namespace hysteron
                 requests[sampler[q]].push_back(q);
               }
         std::vector<std::pair<unsigned int, unsigned int>> replies;
-        for (const auto &[from, blocks] : Collective::exchange(requests, comm))
+        for (const auto &[from, blocks] : dealii::Utilities::MPI::some_to_some(comm, requests))
           for (const unsigned long b : blocks)
             replies.emplace_back(b, from);
         send_blocks(replies);
@@ -428,7 +428,7 @@ namespace hysteron
         // The facets of every block (their lower cells' ranks add them), so the first
         // facet of each block.
         if (n_ranks > 1)
-          Collective::all_reduce(totals, MPI_SUM, comm);
+          dealii::Utilities::MPI::sum(totals, comm, totals);
         std::vector<std::uint64_t> block_first(layout.size() + 1, 0);
         std::partial_sum(totals.begin(), totals.end(), block_first.begin() + 1);
         // A shared block: each of its ranks sends its cells' counts to the others.
@@ -452,7 +452,7 @@ namespace hysteron
             for (const auto &[i, n] : cells[j])
               c[i] = n;
           }
-        for (const auto &[from, message] : Collective::exchange(out, comm))
+        for (const auto &[from, message] : dealii::Utilities::MPI::some_to_some(comm, out))
           for (std::size_t m = 0; m < message.size();)
             {
               auto             &c = counts.at(message[m]);

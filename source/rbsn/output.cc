@@ -140,7 +140,7 @@ namespace hysteron
           std::vector<unsigned long long> best{cell >= 0 && distance == closest ?
                                                  cell_id[cell] :
                                                  std::numeric_limits<unsigned long long>::max()};
-          Collective::all_reduce(best, MPI_MIN, comm);
+          dealii::Utilities::MPI::min(best, comm, best);
           probe_global_cell.push_back(best[0]);
           probe_cell.push_back(cell >= 0 && cell_id[cell] == best[0] ? cell : -1);
           int facet = -1;

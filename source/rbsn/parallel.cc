@@ -18,6 +18,7 @@
 #include <deal.II/lac/trilinos_solver.h>
 #include <deal.II/lac/trilinos_vector.h>
 
+#include "rbsn/collective.h"
 #include "rbsn/model.h"
 
 #include "base/sparse_lu.h"
@@ -232,17 +233,8 @@ namespace hysteron
                   rows.push_back(values[k]);
                 }
             }
-          int              n_mine = rows.size();
-          std::vector<int> counts(n_ranks), offsets(n_ranks, 0);
-          int ierr = MPI_Gather(&n_mine, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
-          AssertThrowMPI(ierr);
-          for (unsigned int r = 1; r < n_ranks; ++r)
-            offsets[r] = offsets[r - 1] + counts[r - 1];
-          std::vector<double> all(root ? offsets.back() + counts.back() : 0);
-          ierr = MPI_Gatherv(rows.data(), n_mine, MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
-                             MPI_DOUBLE, 0, comm);
-          AssertThrowMPI(ierr);
-          int singular = 0;
+          const std::vector<double> all      = Collective::gather(rows, comm, 0);
+          int                       singular = 0;
           if (root)
             {
               matrix = 0;
@@ -263,8 +255,7 @@ namespace hysteron
                   singular = 1;
                 }
             }
-          ierr = MPI_Bcast(&singular, 1, MPI_INT, 0, comm);
-          AssertThrowMPI(ierr);
+          Utilities::MPI::broadcast(&singular, 1, 0, comm);
           if (singular)
             throw singular_tangent();
           factored_parallel.copy_from(parallel_matrix);

@@ -109,10 +109,10 @@ namespace hysteron
         }
       if (distributed())
         {
-          Collective::all_reduce(sizes, MPI_SUM, comm);
-          Collective::all_reduce(measure, MPI_SUM, comm);
-          Collective::all_reduce(lo, MPI_MIN, comm);
-          Collective::all_reduce(hi, MPI_MAX, comm);
+          dealii::Utilities::MPI::sum(sizes, comm, sizes);
+          dealii::Utilities::MPI::sum(measure, comm, measure);
+          dealii::Utilities::MPI::min(lo, comm, lo);
+          dealii::Utilities::MPI::max(hi, comm, hi);
         }
       std::vector<dealii::Point<dim>> centres(n);
       std::vector<double>             extents(n);
@@ -273,7 +273,7 @@ namespace hysteron
         }
       if (distributed())
         {
-          Collective::all_reduce(sums, MPI_SUM, comm);
+          dealii::Utilities::MPI::sum(sums, comm, sums);
           s.released = dealii::Utilities::MPI::sum(s.released, comm);
         }
       if (piece < n_fragments)

@@ -166,7 +166,7 @@ namespace hysteron
             for (unsigned int d = 0; d < dim; ++d)
               all.push_back(r[d]);
           all.insert(all.end(), histories.begin(), histories.end());
-          MPI_Allreduce(MPI_IN_PLACE, all.data(), all.size(), MPI_DOUBLE, MPI_SUM, comm);
+          dealii::Utilities::MPI::sum(all, comm, all);
           auto p = all.begin();
           std::copy(p, p + probes.size(), probes.begin());
           p += probes.size();
