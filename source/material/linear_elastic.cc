@@ -1,9 +1,91 @@
 #include <hysteron/material/linear_elastic.h>
 
+#include <limits>
+#include <vector>
+
 namespace hysteron
 {
   namespace Material
   {
+    namespace
+    {
+      /// Linear springs F = k delta, without state and never yielding (sigma_y = inf).
+      class LinearSprings : public UniaxialSpringLaw
+      {
+      public:
+        double
+        yield_stress() const override
+        {
+          return std::numeric_limits<double>::infinity();
+        }
+
+        bool
+        linear() const override
+        {
+          return true;
+        }
+
+        unsigned int
+        n_state_variables() const override
+        {
+          return 0;
+        }
+
+        unsigned int
+        add_spring(const double k, const double, double *) override
+        {
+          stiffness.push_back(k);
+          return stiffness.size() - 1;
+        }
+
+        unsigned int
+        update(const unsigned int first,
+               const unsigned int n,
+               const double      *increment,
+               double            *force,
+               double            *,
+               double            *tangent,
+               const unsigned int tangent_stride,
+               std::string &) const override
+        {
+          for (unsigned int i = 0; i < n; ++i)
+            {
+              force[i] += stiffness[first + i] * increment[i];
+              if (tangent)
+                tangent[i * tangent_stride] = stiffness[first + i];
+            }
+          return n;
+        }
+
+        double
+        h1(const unsigned int, const double *) const override
+        {
+          return 0;
+        }
+
+        /// 1/2 k delta^2.
+        double
+        strain_energy(const unsigned int spring, const double delta, const double *) const override
+        {
+          return 0.5 * stiffness[spring] * delta * delta;
+        }
+
+      private:
+        std::vector<double> stiffness;
+      };
+    } // namespace
+
+
+
+    template <int dim>
+    std::unique_ptr<UniaxialSpringLaw>
+    LinearElastic<dim>::uniaxial_spring_law() const
+    {
+      return std::make_unique<LinearSprings>();
+    }
+
+
+
     template <int dim>
     void
     LinearElastic<dim>::parse_parameters(const Section &)

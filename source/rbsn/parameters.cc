@@ -77,8 +77,9 @@ namespace hysteron
                           "uncoupled",
                           Patterns::Selection(SpringLawRegistry<dim>::pattern_string()),
                           "The law of the facet springs, a registered plugin (doc/rbsn.md; plugins "
-                          "from Additional shared libraries too). The built-in laws take the facets "
-                          "between Bouc-Wen cells (linear-elastic ones have linear springs); "
+                          "from Additional shared libraries too). The springs follow the uniaxial "
+                          "spring law of the cells' material (bouc-wen, a plugin's; linear "
+                          "elastic ones have linear springs); "
                           "Analysis = static has linear springs throughout:" +
                             SpringLawRegistry<dim>::documentation());
         SpringLawRegistry<dim>::declare_parameters(prm);
@@ -344,10 +345,19 @@ namespace hysteron
                       "a 3D body has no thickness (the 2D out-of-plane depth; its cells are "
                       "volumes and its facets areas): leave it at 1 and give the body its "
                       "depth in its Shape");
-            require(m.spring_behaviour().type != Material::SpringBehaviour::Type::none,
+            // The springs follow the material's uniaxial law (Bouc-Wen, linear, a plugin's).
+            const std::unique_ptr<Material::UniaxialSpringLaw> law = m.uniaxial_spring_law();
+            require(law != nullptr,
                     "Body " + bodies[b].name + "/Material",
-                    "the rbsn method's springs follow the uniaxial Bouc-Wen law: the body's "
-                    "material must be 'bouc-wen' or 'linear elastic'");
+                    "the rbsn method's springs follow the uniaxial spring law of the body's "
+                    "material, which this material does not offer (e.g. 'bouc-wen' or 'linear "
+                    "elastic' do)");
+            require(analysis != Analysis::variable_order || law->linear() ||
+                      law->bouc_wen_parameters(),
+                    "RBSN/Analysis",
+                    "the variable-order analysis integrates the rates of uniaxial Bouc-Wen springs; "
+                    "the springs of the material of body " + bodies[b].name +
+                      " are not Bouc-Wen: use Analysis = implicit dynamics");
             consistent_tangent = consistent_tangent && spring_law->has_consistent_tangent(m);
             const std::string why = spring_law->unsupported(m);
             require(why.empty(), "RBSN/Spring law", why + " (body " + bodies[b].name + ")");

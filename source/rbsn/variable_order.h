@@ -5,6 +5,8 @@
 #include "base/ida_integrator.h"
 #include "base/sparse_lu.h"
 
+#include <hysteron/material/bouc_wen_uniaxial.h>
+
 #include <array>
 #include <vector>
 

@@ -117,12 +117,9 @@ namespace hysteron
         return parameters;
       }
 
-      /// Uniaxial Bouc-Wen springs with these parameters.
-      SpringBehaviour
-      spring_behaviour() const override
-      {
-        return {SpringBehaviour::Type::bouc_wen, &parameters};
-      }
+      /// Uniaxial Bouc-Wen springs (BoucWenUniaxial) with these parameters.
+      std::unique_ptr<UniaxialSpringLaw>
+      uniaxial_spring_law() const override;
 
     protected:
       void

@@ -424,6 +424,14 @@ namespace hysteron
             return call(std::integral_constant<I, I::backward_euler>());
         }
     }
+
+    /// The recoverable energy 1/2 a k delta^2 + 1/2 (1 - a) k z^2 of a Bouc-Wen spring
+    /// with post-yield ratio @p a, stiffness @p k, deformation @p delta and state @p z.
+    inline double
+    bouc_wen_strain_energy(const double a, const double k, const double delta, const double z)
+    {
+      return 0.5 * a * k * delta * delta + 0.5 * (1 - a) * k * z * z;
+    }
   } // namespace Material
 } // namespace hysteron
 

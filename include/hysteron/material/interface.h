@@ -8,7 +8,9 @@
 #include <hysteron/base/parameters.h>
 #include <hysteron/base/registry.h>
 #include <hysteron/material/elasticity.h>
+#include <hysteron/material/uniaxial_spring_law.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,27 +18,6 @@ namespace hysteron
 {
   namespace Material
   {
-    struct BoucWenParameters;
-
-    /**
-     * What a spring network (RBSN) takes from a material for the springs of a
-     * facet between two of its cells: nothing (the material cannot be a body of a
-     * spring network), linear-elastic springs (k from the elastic constants), or
-     * uniaxial Bouc-Wen springs with the material's Bouc-Wen parameters (among them
-     * the yield stress sigma_y that the spring laws scale to yield forces).
-     */
-    struct SpringBehaviour
-    {
-      enum class Type
-      {
-        none,
-        linear_elastic,
-        bouc_wen
-      };
-      Type                     type     = Type::none;
-      const BoucWenParameters *bouc_wen = nullptr; ///< Type::bouc_wen: the parameters
-    };
-
     /**
      * The terms of an axisymmetric tangent besides the in-plane d sigma / d eps:
      * the coupling with the hoop strain eps_tt (d sigma_tt = hoop_by_strain : d eps +
@@ -213,12 +194,13 @@ namespace hysteron
         return n_state_variables() == 0 || !has_consistent_tangent();
       }
 
-      /// What springs between cells of this material follow (default: none, the
-      /// material cannot be a spring network's body).
-      virtual SpringBehaviour
-      spring_behaviour() const
+      /// A new uniaxial law for the springs of a spring network between cells of this
+      /// material (UniaxialSpringLaw), or null (the default): the material then cannot be
+      /// a spring network's body.
+      virtual std::unique_ptr<UniaxialSpringLaw>
+      uniaxial_spring_law() const
       {
-        return {};
+        return nullptr;
       }
 
       /// Warnings found while reading the parameters (printed by the scene on rank 0).

@@ -64,12 +64,9 @@ namespace hysteron
              const dealii::ArrayView<double>                                &states,
              const dealii::ArrayView<dealii::SymmetricTensor<4, dim>> &tangents) const override;
 
-      /// Linear springs.
-      SpringBehaviour
-      spring_behaviour() const override
-      {
-        return {SpringBehaviour::Type::linear_elastic, nullptr};
-      }
+      /// Linear springs, F = k delta.
+      std::unique_ptr<UniaxialSpringLaw>
+      uniaxial_spring_law() const override;
 
     protected:
       void

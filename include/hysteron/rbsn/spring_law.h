@@ -7,14 +7,15 @@
 #include <hysteron/base/exceptions.h>
 #include <hysteron/base/parameters.h>
 #include <hysteron/base/registry.h>
-#include <hysteron/material/bouc_wen_parameters.h>
-#include <hysteron/material/bouc_wen_uniaxial.h>
 #include <hysteron/material/interface.h>
+#include <hysteron/material/uniaxial_spring_law.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hysteron
@@ -155,8 +156,11 @@ namespace hysteron
      * are F = k delta, handled by the network without calling the law; so are all
      * facets with `Analysis = static`.
      *
-     * What a law takes from the cells' materials comes through
-     * Material::Interface::spring_behaviour() (no downcasts).
+     * What a law takes from the cells' materials comes through their uniaxial spring
+     * laws, Material::Interface::uniaxial_spring_law() (no downcasts, no list of
+     * models): the `uncoupled` law drives every spring with it, so any material that
+     * offers one can be a body; laws that are Bouc-Wen by nature ask it for its
+     * Bouc-Wen parameters (Material::UniaxialSpringLaw::bouc_wen_parameters()).
      *
      * Writing a new law: derive from this class, implement the pure virtual
      * functions, optionally a static declare_parameters(ParameterHandler &)
@@ -191,7 +195,8 @@ namespace hysteron
       n_state_variables() const = 0;
 
       /// Why the law cannot join cells of material @p material ("" if it can); an error
-      /// at `RBSN/Spring law` when a body has such a material.
+      /// at `RBSN/Spring law` when a body has such a material. The network asks about
+      /// every body's material before n_state_variables() and setup_facet().
       virtual std::string
       unsupported(const Material::Interface<dim> &material) const
       {
@@ -255,7 +260,7 @@ namespace hysteron
        * uniaxial Bouc-Wen laws: a law that supports it returns "" here and, for
        * every hysteretic facet, the uniaxial law of each spring with the offset of
        * its state in the facet's state. Otherwise the reason (an error at
-       * `RBSN/Spring law`).
+       * `RBSN/Analysis`).
        */
       virtual std::string
       variable_order_unsupported() const
@@ -283,31 +288,53 @@ namespace hysteron
     template <int dim>
     using SpringLawRegistry = Plugins::Registry<SpringLaw<dim>>;
 
-    /// The Bouc-Wen parameters of the springs between cells of materials @p a and @p b
-    /// (those of @p a), or null unless both materials give Bouc-Wen springs.
+    /**
+     * The uniaxial spring laws of the cells' materials (Material::Interface::
+     * uniaxial_spring_law()), one per material, created when first asked for.
+     */
     template <int dim>
-    inline const Material::BoucWenParameters *
-    bouc_wen_springs(const Material::Interface<dim> &a, const Material::Interface<dim> &b)
+    class MaterialSpringLaws
     {
-      return b.spring_behaviour().bouc_wen ? a.spring_behaviour().bouc_wen : nullptr;
-    }
+    public:
+      /// The law of @p material, null if it offers none.
+      Material::UniaxialSpringLaw *
+      operator()(const Material::Interface<dim> &material)
+      {
+        for (auto &law : laws)
+          if (law.first == &material)
+            return law.second.get();
+        laws.emplace_back(&material, material.uniaxial_spring_law());
+        return laws.back().second.get();
+      }
 
-    /// The yield stress sigma_y [Pa] of a facet between two Bouc-Wen materials: the smaller one.
-    template <int dim>
-    inline double
-    facet_yield_stress(const Material::Interface<dim> &a, const Material::Interface<dim> &b)
-    {
-      return std::min(a.spring_behaviour().bouc_wen->yield_stress,
-                      b.spring_behaviour().bouc_wen->yield_stress);
-    }
+      /// The largest n_state_variables() of the laws so far.
+      unsigned int
+      max_n_state_variables() const
+      {
+        unsigned int n = 0;
+        for (const auto &law : laws)
+          n = std::max(n, law.second ? law.second->n_state_variables() : 0u);
+        return n;
+      }
 
-    /// The recoverable energy 1/2 a k delta^2 + 1/2 (1 - a) k z^2 of a Bouc-Wen spring
-    /// with post-yield ratio @p a, stiffness @p k, deformation @p delta and state @p z.
-    inline double
-    bouc_wen_strain_energy(const double a, const double k, const double delta, const double z)
-    {
-      return 0.5 * a * k * delta * delta + 0.5 * (1 - a) * k * z * z;
-    }
+      /**
+       * The springs of a facet between cells of materials @p a and @p b: null if they are
+       * linear (either material's law is, F = k delta), else @p a's law; @p yield_stress
+       * receives the smaller yield stress of the two.
+       */
+      Material::UniaxialSpringLaw *
+      facet(const Material::Interface<dim> &a, const Material::Interface<dim> &b, double &yield_stress)
+      {
+        Material::UniaxialSpringLaw *la = (*this)(a), *lb = (*this)(b);
+        if (la == nullptr || lb == nullptr || la->linear() || lb->linear())
+          return nullptr;
+        yield_stress = std::min(la->yield_stress(), lb->yield_stress());
+        return la;
+      }
+
+    private:
+      std::vector<std::pair<const Material::Interface<dim> *, std::unique_ptr<Material::UniaxialSpringLaw>>> laws;
+    };
   } // namespace RBSN
 } // namespace hysteron
 

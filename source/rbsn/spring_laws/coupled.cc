@@ -1,5 +1,6 @@
 #include <hysteron/material/bouc_wen_interaction.h>
 #include <hysteron/material/bouc_wen_parameters.h>
+#include <hysteron/material/bouc_wen_uniaxial.h>
 #include <hysteron/rbsn/spring_law.h>
 
 #include <string>
@@ -35,11 +36,18 @@ namespace hysteron
           return n;
         }
 
+        /// One interaction surface of Bouc-Wen forces: the material's springs must be
+        /// Bouc-Wen (or linear).
         std::string
         unsupported(const Material::Interface<dim> &material) const override
         {
-          const auto behaviour = material.spring_behaviour();
-          return behaviour.bouc_wen ? Law::unsupported(*behaviour.bouc_wen) : std::string();
+          const Material::UniaxialSpringLaw *law = material_laws(material);
+          if (law == nullptr || law->linear())
+            return law ? std::string() : "the material offers no uniaxial spring law";
+          const Material::BoucWenParameters *prm = law->bouc_wen_parameters();
+          return prm ? Law::unsupported(*prm) :
+                       "the coupled law is one Bouc-Wen interaction surface of the facet's "
+                       "springs; the material's springs are not Bouc-Wen: use the uncoupled law";
         }
 
         bool
@@ -49,11 +57,14 @@ namespace hysteron
                     const Material::Interface<dim> &b,
                     double                       *state) override
         {
-          const Material::BoucWenParameters *prm = bouc_wen_springs<dim>(a, b);
-          if (prm == nullptr)
+          double                             sigma_y = 0;
+          const Material::UniaxialSpringLaw *springs_of = material_laws.facet(a, b, sigma_y);
+          if (springs_of == nullptr)
             return false;
+          const Material::BoucWenParameters *prm = springs_of->bouc_wen_parameters();
+          AssertThrow(prm != nullptr, dealii::ExcMessage("rbsn: coupled springs of a material unsupported()"));
           Facet &facet = facets(e);
-          facet.law.reinit(*prm, springs.k, springs.yield_values(facet_yield_stress<dim>(a, b)));
+          facet.law.reinit(*prm, springs.k, springs.yield_values(sigma_y));
           facet.law.initialize_state(state);
           facet.k = springs.k;
           facet.a = prm->post_yield_ratio;
@@ -90,7 +101,7 @@ namespace hysteron
                       const double       delta,
                       const double      *state) const override
         {
-          return bouc_wen_strain_energy(facets[e].a, facets[e].k[i], delta, state[i]);
+          return Material::bouc_wen_strain_energy(facets[e].a, facets[e].k[i], delta, state[i]);
         }
 
         /// Its springs yield together, they are not uniaxial laws (uniaxial_spring() gives
@@ -114,7 +125,8 @@ namespace hysteron
           Vector k{};
           double a = 0; ///< post-yield ratio
         };
-        PerFacet<Facet> facets;
+        PerFacet<Facet>                 facets;
+        mutable MaterialSpringLaws<dim> material_laws;
       };
     } // namespace
   } // namespace RBSN

@@ -13,8 +13,8 @@ namespace hysteron
        * Rate-independent elastic-perfectly-plastic springs: each spring of the facet
        * (three in 2D, six in 3D) is elastic, F_i = k_i (delta_i - delta^p_i), while
        * |F_i| < F_y,i and flows at |F_i| = F_y,i (FacetSprings::yield_values of the
-       * smaller yield stress of the two cells' Bouc-Wen materials; the Bouc-Wen shape
-       * parameters are not used). The update is the exact return map of the increment:
+       * smaller yield stress of the two cells' materials' uniaxial spring laws; the laws
+       * themselves are not used). The update is the exact return map of the increment:
        * the trial force F + k d delta is cut back to +-F_y, the cut-off part
        * (|F_trial| - F_y) / k is plastic deformation; the tangent is k elastically and 0
        * at yield.
@@ -44,9 +44,10 @@ namespace hysteron
                     const Material::Interface<dim> &b,
                     double                       *state) override
         {
-          if (bouc_wen_springs<dim>(a, b) == nullptr)
+          double sigma_y = 0;
+          if (material_laws.facet(a, b, sigma_y) == nullptr)
             return false;
-          facets(e) = {springs.k, springs.yield_values(facet_yield_stress<dim>(a, b))};
+          facets(e) = {springs.k, springs.yield_values(sigma_y)};
           std::fill(state, state + 2 * n, 0.0);
           return true;
         }
@@ -106,7 +107,8 @@ namespace hysteron
         {
           Vector k{}, yield{};
         };
-        PerFacet<Facet> facets;
+        PerFacet<Facet>         facets;
+        MaterialSpringLaws<dim> material_laws;
       };
     } // namespace
   } // namespace RBSN
@@ -116,5 +118,5 @@ HYSTERON_REGISTER_SPRING_LAW(hysteron::RBSN::ElasticPerfectlyPlastic,
                              "elastic-perfectly-plastic",
                              "independent rate-independent springs (three in 2D, six in 3D), "
                              "elastic (k) up to the yield value of the uncoupled law (from the "
-                             "smaller yield stress of the cells' Bouc-Wen materials) and perfectly "
+                             "smaller yield stress of the cells' materials) and perfectly "
                              "plastic beyond; tangent k or 0; not for Analysis = variable order")

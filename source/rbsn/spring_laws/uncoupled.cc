@@ -1,9 +1,7 @@
-#include <hysteron/base/exceptions.h>
-#include <hysteron/material/bouc_wen_parameters.h>
-#include <hysteron/material/bouc_wen_uniaxial.h>
+#include <hysteron/material/uniaxial_spring_law.h>
 #include <hysteron/rbsn/spring_law.h>
 
-#include <vector>
+#include <string>
 
 namespace hysteron
 {
@@ -12,14 +10,16 @@ namespace hysteron
     namespace
     {
       /**
-       * One independent uniaxial Bouc-Wen law per spring (eq. 3.32-3.36): three in 2D
-       * (normal, tangential, rotational), six in 3D (normal, two shear, two bending,
-       * torsion), each with its own stiffness k_i and yield value F_y,i
-       * (FacetSprings::yield_values of the smaller yield stress of the two cells) and the
-       * Bouc-Wen parameters of cell a's material. The state of spring i lies at
-       * state[3 i] (BoucWenUniaxial::max_n_state_variables each: z, and eta and e_h with
-       * degradation); the tangent is diagonal. The springs are the uniaxial laws that
-       * `Analysis = variable order` integrates (uniaxial_spring()).
+       * One independent uniaxial law per spring (eq. 3.36 for Bouc-Wen materials): three
+       * in 2D (normal, tangential, rotational), six in 3D (normal, two shear, two
+       * bending, torsion), each with its own stiffness k_i and yield value F_y,i
+       * (FacetSprings::yield_values of the smaller yield stress of the two cells). The
+       * springs follow the uniaxial spring law of cell a's material
+       * (Material::Interface::uniaxial_spring_law()), so any material that offers one
+       * drives the springs; facets with a linear material are F = k delta. The state of
+       * spring i lies at state[stride i], stride the largest n_state_variables() of the
+       * bodies' laws; the tangent is diagonal. Springs of Bouc-Wen materials are the
+       * uniaxial laws that `Analysis = variable order` integrates (uniaxial_spring()).
        */
       template <int dim>
       class Uncoupled : public SpringLaw<dim>
@@ -29,7 +29,16 @@ namespace hysteron
         using typename SpringLaw<dim>::Matrix;
         static constexpr unsigned int n = SpringLaw<dim>::n;
 
-        static constexpr unsigned int stride = Material::BoucWenUniaxial::max_n_state_variables;
+        /// The network asks about every body's material first: its law fixes the stride.
+        std::string
+        unsupported(const Material::Interface<dim> &material) const override
+        {
+          if (material_laws(material) == nullptr)
+            return "the material offers no uniaxial spring law "
+                   "(Material::Interface::uniaxial_spring_law())";
+          stride = material_laws.max_n_state_variables();
+          return "";
+        }
 
         unsigned int
         n_state_variables() const override
@@ -38,21 +47,26 @@ namespace hysteron
         }
 
         bool
-        setup_facet(const unsigned int            e,
-                    const FacetSprings<dim>      &springs,
+        setup_facet(const unsigned int              e,
+                    const FacetSprings<dim>        &springs,
                     const Material::Interface<dim> &a,
                     const Material::Interface<dim> &b,
-                    double                       *state) override
+                    double                         *state) override
         {
-          const Material::BoucWenParameters *prm = bouc_wen_springs<dim>(a, b);
-          if (prm == nullptr)
+          double                       sigma_y = 0;
+          Material::UniaxialSpringLaw *law     = material_laws.facet(a, b, sigma_y);
+          if (law == nullptr)
             return false;
-          auto      &facet = laws(e);
-          const auto yield = springs.yield_values(facet_yield_stress<dim>(a, b));
+          AssertThrow(law->n_state_variables() <= stride,
+                      dealii::ExcMessage("rbsn: a material not asked about by unsupported()"));
+          const auto yield = springs.yield_values(sigma_y);
+          Facet     &facet = facets(e);
+          facet.law        = law;
           for (unsigned int i = 0; i < n; ++i)
             {
-              facet[i].reinit(*prm, springs.k[i], yield[i]);
-              facet[i].initialize_state(state + stride * i);
+              const unsigned int s = law->add_spring(springs.k[i], yield[i], state + stride * i);
+              if (i == 0)
+                facet.first = s;
             }
           return true;
         }
@@ -63,6 +77,8 @@ namespace hysteron
           return true;
         }
 
+        /// One call of the material's law for the facet's springs (D[i][i] at stride n + 1
+        /// in the n x n tensor's contiguous components).
         void
         update(const unsigned int e,
                const Vector      &increment,
@@ -70,28 +86,18 @@ namespace hysteron
                double            *state,
                Matrix            *tangent) const override
         {
-          // Every spring is advanced even if one fails, so that the trial state is the
-          // same as spring-by-spring; the last failure is reported.
-          std::string cause, spring;
-          for (unsigned int i = 0; i < n; ++i)
-            try
-              {
-                laws[e][i].update(increment[i], force[i], state + stride * i,
-                                  tangent ? &(*tangent)[i][i] : nullptr);
-              }
-            catch (const RuntimeError &error)
-              {
-                cause  = error.what();
-                spring = std::string("the ") + spring_name<dim>(i) + " spring";
-              }
-          if (!cause.empty())
-            throw SpringFailure(cause, spring);
+          const Facet &facet = facets[e];
+          std::string  cause;
+          const unsigned int failed = facet.law->update(facet.first, n, increment.data(), force.data(), state,
+                                                        tangent ? &(*tangent)[0][0] : nullptr, n + 1, cause);
+          if (failed < n)
+            throw SpringFailure(cause, std::string("the ") + spring_name<dim>(failed) + " spring");
         }
 
         double
         h1(const unsigned int e, const unsigned int i, const double *state) const override
         {
-          return laws[e][i].h1(state + stride * i);
+          return facets[e].law->h1(facets[e].first + i, state + stride * i);
         }
 
         double
@@ -100,9 +106,7 @@ namespace hysteron
                       const double       delta,
                       const double      *state) const override
         {
-          const auto &law = laws[e][i];
-          return bouc_wen_strain_energy(law.parameters().post_yield_ratio, law.stiffness(), delta,
-                                        state[stride * i]);
+          return facets[e].law->strain_energy(facets[e].first + i, delta, state + stride * i);
         }
 
         std::string
@@ -114,11 +118,19 @@ namespace hysteron
         typename SpringLaw<dim>::UniaxialSpring
         uniaxial_spring(const unsigned int e, const unsigned int i) const override
         {
-          return {&laws[e][i], stride * i};
+          return {facets[e].law->bouc_wen(facets[e].first + i), stride * i};
         }
 
       private:
-        PerFacet<std::array<Material::BoucWenUniaxial, n>> laws;
+        /// A hysteretic facet: its material's law and the number of its first spring there.
+        struct Facet
+        {
+          const Material::UniaxialSpringLaw *law   = nullptr;
+          unsigned int                       first = 0;
+        };
+        PerFacet<Facet> facets;
+        mutable MaterialSpringLaws<dim> material_laws;
+        mutable unsigned int            stride = 0;
       };
     } // namespace
   } // namespace RBSN
@@ -126,9 +138,10 @@ namespace hysteron
 
 HYSTERON_REGISTER_SPRING_LAW(hysteron::RBSN::Uncoupled,
                              "uncoupled",
-                             "one uniaxial Bouc-Wen law per spring (eq. 3.36), each yielding at its "
+                             "one uniaxial law per spring, the cells' material's (Bouc-Wen: eq. "
+                             "3.36), each yielding at its "
                              "own F_y: 2D sigma_y t l (normal), sigma_y t l / sqrt(3) (tangential), "
                              "factor sigma_y t l^2 (rotational); 3D sigma_y A (normal), "
                              "sigma_y A / sqrt(3) (shear), factor sigma_y A sqrt(12 I / A) "
                              "(bending), factor sigma_y / sqrt(3) A sqrt(12 J / A) (torsion); "
-                             "sigma_y and the Bouc-Wen parameters from the cells' material")
+                             "sigma_y and the law from the cells' material")
