@@ -1,27 +1,10 @@
-// The increment control, the constraints and the failure message of an implicit increment (FEM, RBSN).
+// The constraints and the failure message of an implicit increment (FEM, RBSN).
 #include "implicit_step.h"
-
-#include <hysteron/scene/scene.h>
 
 #include <sstream>
 
 namespace hysteron
 {
-  IncrementControl
-  increment_control(const double nominal, const unsigned int max_cuts, const TimeControl &time, const bool load_steps)
-  {
-    IncrementControl increments(nominal, max_cuts);
-    if (load_steps && !time.steps.empty())
-      {
-        std::vector<double> ends, nominals;
-        time.step_grid(ends, nominals);
-        increments.set_steps(ends, nominals);
-      }
-    return increments;
-  }
-
-
-
   void
   constrain_prescribed(dealii::AffineConstraints<double>                  &constraints,
                        const dealii::IndexSet                             &relevant_dofs,

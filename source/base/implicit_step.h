@@ -13,16 +13,25 @@
 
 namespace hysteron
 {
-  struct TimeControl;
-
   /**
    * The increment control of an implicit method: nominal increments @p nominal, halved at
    * most @p max_cuts times when Newton fails, and with @p load_steps the nominal
-   * increments of the scene's load steps (`Time/Steps`, each step's length over its
-   * number of increments) instead.
+   * increments of the scene's load steps (@p time a TimeControl: `Time/Steps`, each
+   * step's length over its number of increments) instead.
    */
+  template <typename Time>
   IncrementControl
-  increment_control(double nominal, unsigned int max_cuts, const TimeControl &time, bool load_steps);
+  increment_control(const double nominal, const unsigned int max_cuts, const Time &time, const bool load_steps)
+  {
+    IncrementControl increments(nominal, max_cuts);
+    if (load_steps && !time.steps.empty())
+      {
+        std::vector<double> ends, nominals;
+        time.step_grid(ends, nominals);
+        increments.set_steps(ends, nominals);
+      }
+    return increments;
+  }
 
   /**
    * What one increment from the converged state u to t1 asks of an implicit method whose

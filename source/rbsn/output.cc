@@ -226,10 +226,7 @@ namespace hysteron
           totals[2 * r + 1] = inside[r].size();
         }
       if (distributed() && !regions.empty())
-        {
-          const int ierr = MPI_Allreduce(MPI_IN_PLACE, totals.data(), totals.size(), MPI_DOUBLE, MPI_SUM, comm);
-          AssertThrowMPI(ierr);
-        }
+        dealii::Utilities::MPI::sum(totals, comm, totals);
       for (unsigned int r = 0; r < regions.size(); ++r)
         {
           double *avg = averages.data() + r * (1 + n_values);
