@@ -482,6 +482,27 @@ namespace hysteron
       point_values(const int c, const int e, const dealii::Point<dim> &x, double *out) const;
       /// The number of cell columns of point_columns().
       static constexpr unsigned int n_cell_columns = 3 * dim + 2 * (n_dofs - dim);
+      /// The number of columns of point_columns() without the additional ones.
+      static constexpr unsigned int n_base_columns = n_cell_columns + 2 * n_dofs + 3;
+      /// The Love-Weber stress and the strain fitted to the facets' jumps of every owned
+      /// cell, for `Output/Additional columns` (cell_tensors.cc; collective).
+      void
+      cell_tensors(std::vector<dealii::SymmetricTensor<2, dim>> &stress,
+                   std::vector<dealii::SymmetricTensor<2, dim>> &strain) const;
+      /// The pseudo-inverse of the symmetric @p N.
+      static dealii::Tensor<2, dim>
+      pseudo_inverse(const dealii::SymmetricTensor<2, dim> &N);
+      /// The additional columns of a cell with @p stress, @p strain and @p material at the
+      /// point whose x, u, v (the first 3 dim values of point_values()) are in @p base.
+      void
+      additional_values(const double                          *base,
+                        const dealii::SymmetricTensor<2, dim> &stress,
+                        const dealii::SymmetricTensor<2, dim> &strain,
+                        const Material::Interface<dim>        &material,
+                        double                                *out) const;
+      /// The material of every scene body.
+      std::vector<const Material::Interface<dim> *>
+      body_materials() const;
 
       // Analysis = variable order (variable_order.cc): the DAE in (u, v, s) and IDA.
       class VariableOrder;

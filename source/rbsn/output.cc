@@ -22,14 +22,19 @@ namespace hysteron
     std::vector<std::string>
     Model<dim>::point_columns() const
     {
+      std::vector<std::string> columns;
       if constexpr (dim == 2)
-        return {"x_x", "x_y", "u_x", "u_y", "v_x", "v_y", "theta", "omega",
-                "f_n", "f_t", "m", "s_n", "s_t", "H1_n", "H1_t", "H1_m", "broken"};
+        columns = {"x_x", "x_y", "u_x", "u_y", "v_x", "v_y", "theta", "omega",
+                   "f_n", "f_t", "m", "s_n", "s_t", "H1_n", "H1_t", "H1_m", "broken"};
       else
-        return {"x_x",     "x_y",     "x_z",     "u_x",     "u_y",     "u_z",   "v_x",  "v_y",
-                "v_z",     "theta_x", "theta_y", "theta_z", "omega_x", "omega_y", "omega_z",
-                "f_n",     "f_1",     "f_2",     "m_1",     "m_2",     "m_t",   "s_n",  "s_t",
-                "H1_n",    "H1_1",    "H1_2",    "H1_b1",   "H1_b2",   "H1_t",  "broken"};
+        columns = {"x_x",     "x_y",     "x_z",     "u_x",     "u_y",     "u_z",   "v_x",  "v_y",
+                   "v_z",     "theta_x", "theta_y", "theta_z", "omega_x", "omega_y", "omega_z",
+                   "f_n",     "f_1",     "f_2",     "m_1",     "m_2",     "m_t",   "s_n",  "s_t",
+                   "H1_n",    "H1_1",    "H1_2",    "H1_b1",   "H1_b2",   "H1_t",  "broken"};
+      // The cell's output column plugins last (cell_tensors.cc).
+      const std::vector<std::string> additional = scene().output_control().additional_columns.names();
+      columns.insert(columns.end(), additional.begin(), additional.end());
+      return columns;
     }
 
 
@@ -208,6 +213,19 @@ namespace hysteron
       std::vector<double> rows(probes.size() * n_values);
       for (unsigned int i = 0; i < probes.size(); ++i)
         point_values(probe_cell[i], probe_facet[i], probes[i], rows.data() + i * n_values);
+      // The output column plugins: of the probe's cell, and mass-weighted in the averages.
+      std::vector<dealii::SymmetricTensor<2, dim>> cell_stress, cell_strain;
+      std::vector<const Material::Interface<dim> *> materials;
+      const bool additional = n_values > n_base_columns;
+      if (additional)
+        {
+          cell_tensors(cell_stress, cell_strain);
+          materials = body_materials();
+          for (unsigned int i = 0; i < probes.size(); ++i)
+            if (const int c = probe_cell[i]; c >= 0)
+              additional_values(rows.data() + i * n_values, cell_stress[c], cell_strain[c],
+                                *materials[cell_body[c]], rows.data() + i * n_values + n_base_columns);
+        }
 
       // Averages: cell columns mass-weighted over the cells whose nucleus is in the
       // region; facet columns the mean over the facets whose midpoint is in it.
@@ -234,14 +252,18 @@ namespace hysteron
             if (regions[r].contains(local_nuclei[c], 1e-9 * scale))
               {
                 point_values(c, -1, local_nuclei[c], values.data());
+                if (additional)
+                  additional_values(values.data(), cell_stress[c], cell_strain[c], *materials[cell_body[c]],
+                                    values.data() + n_base_columns);
                 avg[0] += cell_mass[c];
-                for (unsigned int k = 0; k < n_cell_columns; ++k)
-                  avg[1 + k] += cell_mass[c] * values[k];
+                for (unsigned int k = 0; k < n_values; ++k)
+                  if (k < n_cell_columns || k >= n_base_columns)
+                    avg[1 + k] += cell_mass[c] * values[k];
               }
           for (const unsigned int e : inside[r])
             {
               point_values(-1, e, network.facets[e].midpoint, values.data());
-              for (unsigned int k = n_cell_columns; k < n_values; ++k)
+              for (unsigned int k = n_cell_columns; k < n_base_columns; ++k)
                 avg[1 + k] += totals[2 * r] / totals[2 * r + 1] * values[k];
             }
         }
@@ -400,6 +422,19 @@ namespace hysteron
         columns.push_back("theta");
       else
         columns.insert(columns.end(), {"u_z", "theta_x", "theta_y", "theta_z"});
+      // The output column plugins of each cell at its nucleus (cell_tensors.cc).
+      const auto &additional = scene().output_control().additional_columns;
+      std::vector<dealii::SymmetricTensor<2, dim>> cell_stress, cell_strain;
+      std::vector<const Material::Interface<dim> *> materials;
+      std::vector<double> values;
+      if (!additional.empty())
+        {
+          const std::vector<std::string> names = additional.names();
+          columns.insert(columns.end(), names.begin(), names.end());
+          cell_tensors(cell_stress, cell_strain);
+          materials = body_materials();
+          values.resize(n_base_columns + names.size());
+        }
       std::vector<double> rows;
       for (unsigned int c = 0; c < n_owned_cells; ++c)
         {
@@ -410,6 +445,13 @@ namespace hysteron
           rows.push_back(cell_measure(c));
           for (unsigned int k = 0; k < n_dofs; ++k)
             rows.push_back(u.local_element(n_dofs * c + k));
+          if (!additional.empty())
+            {
+              point_values(c, -1, local_nuclei[c], values.data());
+              additional_values(values.data(), cell_stress[c], cell_strain[c], *materials[cell_body[c]],
+                                values.data() + n_base_columns);
+              rows.insert(rows.end(), values.begin() + n_base_columns, values.end());
+            }
         }
       const std::vector<double> all = distributed() ? Collective::gather(rows, network_communicator(), 0) : rows;
       if (!scene().is_root())

@@ -4,6 +4,7 @@
 #include <hysteron/base/parameters.h>
 #include "rbsn/model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -232,11 +233,6 @@ namespace hysteron
     void
     Model<dim>::parse_parameters(dealii::ParameterHandler &prm)
     {
-      // The network's tables have cell and facet columns, not continuum points.
-      require(scene().output_control().additional_columns.empty(),
-              "Output/Additional columns",
-              "the rbsn method's probe tables hold cell and facet values; additional point "
-              "columns apply to the mpm and fem methods");
       scene().refuse_fem_only_sets("rbsn", true);
       {
         Section s(prm, {"RBSN"});
@@ -366,6 +362,14 @@ namespace hysteron
                     "only dynamic analyses have velocities");
           }
       require(!body_shapes.empty(), "Body names", "the rbsn method needs a body that is not rigid");
+      std::vector<const Material::Interface<dim> *> materials;
+      for (const unsigned int b : mesh_body)
+        {
+          const auto *m = &scene().material(bodies[b].material, "Body " + bodies[b].name + "/Material");
+          if (std::find(materials.begin(), materials.end(), m) == materials.end())
+            materials.push_back(m);
+        }
+      spring_law->initialize(materials);
       for (const auto &b : scene().boundary_descriptions())
         require(b.type != BoundaryDescription<dim>::Type::wall,
                 "Boundary " + b.name + "/Type",

@@ -148,9 +148,10 @@ namespace hysteron
       prm.declare_entry("Additional columns",
                         "",
                         Patterns::MultipleSelection(PointData::ColumnRegistry<3>::pattern_string()),
-                        "Output column plugins appended to every point table of the mpm and fem "
-                        "methods (probe_<i>.csv, average_<i>.csv, particles.csv, "
-                        "quadrature_points.csv), in the order given. Registered columns:" +
+                        "Output column plugins appended to every point table, in the order given: "
+                        "probe_<i>.csv and average_<i>.csv, and particles.csv (mpm), "
+                        "quadrature_points.csv (fem) or cells.csv (rbsn, a cell's Love-Weber "
+                        "stress and fitted strain: doc/rbsn.md). Registered columns:" +
                           PointData::ColumnRegistry<3>::documentation());
       PointData::ColumnRegistry<3>::declare_parameters(prm);
       prm.declare_entry("Average regions",

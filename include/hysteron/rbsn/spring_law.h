@@ -196,12 +196,20 @@ namespace hysteron
 
       /// Why the law cannot join cells of material @p material ("" if it can); an error
       /// at `RBSN/Spring law` when a body has such a material. The network asks about
-      /// every body's material before n_state_variables() and setup_facet().
+      /// every body's material before initialize().
       virtual std::string
       unsupported(const Material::Interface<dim> &material) const
       {
         (void)material;
         return "";
+      }
+
+      /// The materials of the network's bodies (each once, every one accepted by
+      /// unsupported()), before n_state_variables() and setup_facet().
+      virtual void
+      initialize(const std::vector<const Material::Interface<dim> *> &materials)
+      {
+        (void)materials;
       }
 
       /**

@@ -18,11 +18,12 @@ namespace hysteron
   namespace PointData
   {
     /**
-     * What a point of a continuum method (an MPM material point, an FEM
-     * quadrature point) offers an output column: its position, displacement,
-     * velocity, stress and strain (tensor shear components), its material (null
-     * for a rigid point) and the material's state variables, and in 2D the
-     * out-of-plane stress sigma_zz (0 in plane stress).
+     * What a point offers an output column (an MPM material point, an FEM
+     * quadrature point, an RBSN cell with its Love-Weber stress and the strain
+     * fitted to its facets, doc/rbsn.md): its position, displacement, velocity,
+     * stress and strain (tensor shear components), its material (null for a rigid
+     * point) and the material's state variables (none for an RBSN cell), and in 2D
+     * the out-of-plane stress sigma_zz (0 in plane stress).
      */
     template <int dim>
     struct PointView
@@ -39,9 +40,9 @@ namespace hysteron
 
     /**
      * An output column plugin: one or more columns computed from a point, appended
-     * to every point table of the MPM and the FEM (probe_<i>.csv, average_<i>.csv,
-     * particles.csv, quadrature_points.csv) when named in `Output/Additional
-     * columns`. Adding one takes one class and one registration line:
+     * to every point table of the MPM, the FEM and the RBSN (probe_<i>.csv,
+     * average_<i>.csv, particles.csv, quadrature_points.csv, cells.csv) when named in
+     * `Output/Additional columns`. Adding one takes one class and one registration line:
      *
      *   template <int dim>
      *   class Pressure : public PointData::Column<dim>

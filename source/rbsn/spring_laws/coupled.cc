@@ -3,6 +3,7 @@
 #include <hysteron/material/bouc_wen_uniaxial.h>
 #include <hysteron/rbsn/spring_law.h>
 
+#include <memory>
 #include <string>
 #include <type_traits>
 
@@ -41,7 +42,7 @@ namespace hysteron
         std::string
         unsupported(const Material::Interface<dim> &material) const override
         {
-          const Material::UniaxialSpringLaw *law = material_laws(material);
+          const std::unique_ptr<Material::UniaxialSpringLaw> law = material.uniaxial_spring_law();
           if (law == nullptr || law->linear())
             return law ? std::string() : "the material offers no uniaxial spring law";
           const Material::BoucWenParameters *prm = law->bouc_wen_parameters();
@@ -126,7 +127,7 @@ namespace hysteron
           double a = 0; ///< post-yield ratio
         };
         PerFacet<Facet>                 facets;
-        mutable MaterialSpringLaws<dim> material_laws;
+        MaterialSpringLaws<dim> material_laws;
       };
     } // namespace
   } // namespace RBSN

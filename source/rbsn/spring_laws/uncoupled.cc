@@ -29,15 +29,22 @@ namespace hysteron
         using typename SpringLaw<dim>::Matrix;
         static constexpr unsigned int n = SpringLaw<dim>::n;
 
-        /// The network asks about every body's material first: its law fixes the stride.
         std::string
         unsupported(const Material::Interface<dim> &material) const override
         {
-          if (material_laws(material) == nullptr)
+          if (material.uniaxial_spring_law() == nullptr)
             return "the material offers no uniaxial spring law "
                    "(Material::Interface::uniaxial_spring_law())";
-          stride = material_laws.max_n_state_variables();
           return "";
+        }
+
+        /// The bodies' laws fix the stride: the largest state of a spring.
+        void
+        initialize(const std::vector<const Material::Interface<dim> *> &materials) override
+        {
+          for (const auto *material : materials)
+            material_laws(*material);
+          stride = material_laws.max_n_state_variables();
         }
 
         unsigned int
@@ -58,7 +65,7 @@ namespace hysteron
           if (law == nullptr)
             return false;
           AssertThrow(law->n_state_variables() <= stride,
-                      dealii::ExcMessage("rbsn: a material not asked about by unsupported()"));
+                      dealii::ExcMessage("rbsn: a material not given to initialize()"));
           const auto yield = springs.yield_values(sigma_y);
           Facet     &facet = facets(e);
           facet.law        = law;
@@ -129,8 +136,8 @@ namespace hysteron
           unsigned int                       first = 0;
         };
         PerFacet<Facet> facets;
-        mutable MaterialSpringLaws<dim> material_laws;
-        mutable unsigned int            stride = 0;
+        MaterialSpringLaws<dim> material_laws;
+        unsigned int            stride = 0;
       };
     } // namespace
   } // namespace RBSN
