@@ -152,6 +152,9 @@ namespace
           c.name = entry.name;
           c.law  = RBSN::SpringLawRegistry<dim>::create(entry.name, "RBSN/Spring law");
           EXPECT_EQ(c.law->unsupported(*a), "") << c.name;
+          EXPECT_EQ(c.law->unsupported(*b), "") << c.name;
+          // The network hands the law its bodies' materials before the facets.
+          c.law->initialize({a.get(), b.get()});
           for (unsigned int e = 0; e < facets.size(); ++e)
             {
               c.states.emplace_back(c.law->n_state_variables(), -1.0);
