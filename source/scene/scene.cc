@@ -5,6 +5,7 @@
 #include <hysteron/base/output.h>
 #include <hysteron/base/parameters.h>
 #include <hysteron/scene/output_column.h>
+#include <hysteron/scene/ground_motion.h>
 #include <hysteron/scene/scene.h>
 
 #include <algorithm>
@@ -210,6 +211,9 @@ namespace hysteron
       }
 
     declare_scene_descriptions(prm, names);
+    prm.enter_subsection("Ground motion");
+    GroundMotion::declare_parameters(prm);
+    prm.leave_subsection();
     Amplitude::declare_parameters(prm, names.amplitudes);
     Methods::Registry<3>::declare_parameters(prm);
   }
@@ -372,6 +376,15 @@ namespace hysteron
     effective_parameters_ = "# Parameters of this hysteron " HYSTERON_VERSION " run (" +
                            options.parameter_file + "), defaults included.\n" + text.str();
 
+    // A record that a method would not read must not pass silently.
+    {
+      Section ground(prm, {"Ground motion"});
+      require(dealii::Utilities::trim(ground.get("File")).empty() || method_name_ == "oscillator" ||
+                method_name_ == "spectrum",
+              ground.where("File"),
+              "the " + method_name_ + " method does not take a ground motion (the oscillator and "
+              "spectrum methods do)");
+    }
     method = Methods::Registry<dim>::create(method_name_, "Method");
     method->initialize(*this, prm);
   }

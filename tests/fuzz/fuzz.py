@@ -101,7 +101,7 @@ class Scene:
                 key, value = words[4:].split("=", 1)
                 self.entries.append((i, "/".join(stack), key.strip(), value.strip()))
         self.inputs = [value for _, _, key, value in self.entries
-                       if key == "Mesh file" and value]
+                       if key in ("Mesh file", "File") and value]
 
 
 def value_mutations(key, value):
