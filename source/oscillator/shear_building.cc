@@ -154,9 +154,8 @@ namespace hysteron
 
 
     bool
-    ShearBuilding::step(State &s, const double t, const double dt, const double ground, std::string &failure)
+    ShearBuilding::step(State &s, const double dt, const double ground, std::string &failure)
     {
-      (void)t;
       const unsigned int n  = mass.size();
       const double       c0 = 1 / (newmark_beta * dt * dt), c1 = newmark_gamma / (newmark_beta * dt);
       // The predictor: a_{n+1} = 0.
@@ -255,7 +254,7 @@ namespace hysteron
               dt               = std::min(dt, t1 - t);
               const double ag1 = ground(t + dt);
               old              = s;
-              if (!step(s, t, dt, ag1, failure))
+              if (!step(s, dt, ag1, failure))
                 {
                   ++n_cuts;
                   dt /= 2;

@@ -122,9 +122,10 @@ namespace hysteron
       unsigned long n_steps = 0, n_newton = 0, n_cuts = 0;
 
     private:
-      /// Advance @p s (into trial, then swapped) from t by dt; false if it failed.
+      /// Advance @p s (into trial, then swapped) by @p dt to the ground acceleration
+      /// @p ground at the step's end; false if it failed.
       bool
-      step(State &s, double t, double dt, double ground, std::string &failure);
+      step(State &s, double dt, double ground, std::string &failure);
       /// The storeys' forces and tangents at the drifts of trial from s.
       bool
       storey_forces(const State &s, std::string &failure);

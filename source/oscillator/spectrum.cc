@@ -55,6 +55,12 @@ namespace hysteron
       parse_parameters(dealii::ParameterHandler &prm) override;
 
     private:
+      /// The step of period @p T: the input's step in equal parts of at most T / `Steps per period`.
+      double
+      step_for(const double T) const
+      {
+        return ground.time_step / std::ceil(ground.time_step * steps_per_period / T - 1e-9);
+      }
       /// The elastic peak displacement of period @p T (exact between samples).
       double
       elastic_peak(double T) const;
@@ -183,7 +189,7 @@ namespace hysteron
       // record's samples is seen (at 10 points per period the sampled peak can be 5 %
       // low).
       const double w = 2 * M_PI / T, z = damping_ratio, wd = w * std::sqrt(1 - z * z);
-      const double h = ground.time_step / std::ceil(ground.time_step * steps_per_period / T - 1e-9);
+      const double h = step_for(T);
       const double decay = std::exp(-z * w * h), c = std::cos(wd * h), s = std::sin(wd * h);
       double       u = 0, v = 0, peak = 0, a0 = ground(0);
       const auto   n = static_cast<unsigned long>(std::ceil(ground.duration / h - 1e-9));
@@ -214,8 +220,7 @@ namespace hysteron
       ShearBuilding sdof({1.0}, {w * w}, {yield}, damping_ratio,
                          this->get_scene().material("", "Material").uniaxial_spring_law());
       double        peak = 0;
-      sdof.integrate(std::cref(ground), ground.time_step / std::ceil(ground.time_step * steps_per_period / T - 1e-9),
-                     ground.duration,
+      sdof.integrate(std::cref(ground), step_for(T), ground.duration,
                      [&](double t, double, const ShearBuilding::State &s, const ShearBuilding::Energies &) {
                        peak = std::max(peak, std::abs(s.u[0]));
                        if (signals && t > 0)
