@@ -69,6 +69,13 @@ namespace hysteron
           }
       }
 
+      /// The compared methods are field methods: a material must serve a continuum.
+      bool
+      takes_continuum_materials() const override
+      {
+        return true;
+      }
+
       std::string
       check_size() override
       {

@@ -145,6 +145,12 @@ namespace hysteron
         return "";
       }
 
+      bool
+      takes_continuum_materials() const override
+      {
+        return true;
+      }
+
     protected:
       void
       parse_parameters(dealii::ParameterHandler &prm) override;

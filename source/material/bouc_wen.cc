@@ -184,6 +184,10 @@ namespace hysteron
     {
       for (const auto &w : parameters.parse_parameters(section))
         this->add_warning(w);
+      {
+        Section bouc_wen(section, "Bouc-Wen");
+        family.parse_parameters(bouc_wen, parameters);
+      }
 
       const Elasticity &el = this->elasticity();
       stress_state         = dim == 3 ? StressState::three_dimensional : el.stress_state;

@@ -1,3 +1,4 @@
+#include <hysteron/material/bouc_wen_family.h>
 #include <hysteron/material/bouc_wen_parameters.h>
 
 #include <cmath>
@@ -77,6 +78,7 @@ namespace hysteron
                             "dissipated energy density; 0 switches strength deterioration off.");
         }
         prm.leave_subsection();
+        BoucWenFamilyParameters::declare_parameters(prm);
       }
       prm.leave_subsection();
     }

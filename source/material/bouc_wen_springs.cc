@@ -77,6 +77,12 @@ namespace hysteron
         }
 
         double
+        hysteretic_variable(const unsigned int, const double *state) const override
+        {
+          return state[BoucWenUniaxial::z_index];
+        }
+
+        double
         strain_energy(const unsigned int spring, const double delta, const double *state) const override
         {
           const BoucWenUniaxial &law = springs[spring];
@@ -108,12 +114,29 @@ namespace hysteron
     std::unique_ptr<UniaxialSpringLaw>
     BoucWen<dim>::uniaxial_spring_law() const
     {
+      if (family.variant != UniaxialVariant::smooth)
+        return create_bouc_wen_variant(family, parameters.yield_stress);
       return std::make_unique<BoucWenSprings>(parameters);
+    }
+
+    template <int dim>
+    std::string
+    BoucWen<dim>::continuum_unsupported() const
+    {
+      if (family.variant == UniaxialVariant::smooth)
+        return "";
+      return "Bouc-Wen/Uniaxial law = " + family.name() +
+             " is a law for springs and uniaxial points (the rbsn, oscillator, spectrum and uniaxial "
+             "methods); a continuum takes the smooth triaxial law: set Uniaxial law = smooth";
     }
 
     template std::unique_ptr<UniaxialSpringLaw>
     BoucWen<2>::uniaxial_spring_law() const;
     template std::unique_ptr<UniaxialSpringLaw>
     BoucWen<3>::uniaxial_spring_law() const;
+    template std::string
+    BoucWen<2>::continuum_unsupported() const;
+    template std::string
+    BoucWen<3>::continuum_unsupported() const;
   } // namespace Material
 } // namespace hysteron

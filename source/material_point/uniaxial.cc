@@ -72,6 +72,13 @@ namespace hysteron
       Material::BoucWenParameters    parameters;
       const std::vector<std::string> warnings = parameters.parse_parameters(material);
       law.reinit(parameters, E, parameters.yield_stress);
+      {
+        Section                           bouc_wen(material, "Bouc-Wen");
+        Material::BoucWenFamilyParameters family;
+        family.parse_parameters(bouc_wen, parameters);
+        if (family.variant != Material::UniaxialVariant::smooth)
+          variant = Material::create_bouc_wen_variant(family, parameters.yield_stress);
+      }
 
       // The scene prints the warnings of its material model; print ours unless
       // that model (a Bouc-Wen model) has printed the same ones already.
@@ -91,6 +98,8 @@ namespace hysteron
     Uniaxial<dim>::column_names() const
     {
       std::vector<std::string> names{"t", "eps", "sig", "z"};
+      if (variant)
+        return {"t", "eps", "sig", "z", "H1"};
       if (law.degradation())
         for (const char *c : {"eta", "e_h", "nu_s"})
           names.push_back(c);
@@ -102,9 +111,72 @@ namespace hysteron
 
 
     template <int dim>
+    double
+    Uniaxial<dim>::strain_at(const unsigned int step) const
+    {
+      const double t     = end_time * step / n_steps;
+      const double value = strain->value(dealii::Point<1>(t));
+      if (!std::isfinite(value))
+        {
+          std::ostringstream m;
+          m << "Uniaxial: the strain is not finite at step " << step << " (t = " << t << " s)";
+          throw RuntimeError(m.str());
+        }
+      return value;
+    }
+
+
+
+    template <int dim>
+    void
+    Uniaxial<dim>::run_variant()
+    {
+      const Scene<dim> &scene = this->get_scene();
+      std::unique_ptr<Output::TimeTable> csv;
+      if (scene.is_root())
+        csv = std::make_unique<Output::TimeTable>(scene.output_file("history.csv"),
+                                                  column_names(),
+                                                  this->run_record());
+      const double E = scene.material("", "Material").elasticity().youngs_modulus;
+      double       state[3];
+      variant->add_spring(E, variant->yield_stress(), state);
+      double      eps = 0, stress = 0;
+      std::string failure;
+      const auto  advance = [&](const unsigned int step) {
+        const double next = strain_at(step);
+        double       deps = next - eps;
+        if (variant->update(0, 1, &deps, &stress, state, nullptr, 1, failure) != 1)
+          throw RuntimeError(failure + " [at step " + std::to_string(step) + "]");
+        eps = next;
+        std::vector<double> row{end_time * step / n_steps, eps, stress,
+                                variant->hysteretic_variable(0, state), variant->h1(0, state)};
+        if (csv)
+          csv->add_row(row);
+        rows.push_back(std::move(row));
+      };
+      Progress progress(scene.console(), "uniaxial", end_time, scene.output_control().progress_interval);
+      dealii::TimerOutput::Scope timing(scene.timer(), "material updates");
+      // Step 0 loads the path's start from the virgin state in one increment.
+      for (unsigned int step = 0; step <= n_steps; ++step)
+        {
+          advance(step);
+          progress.update(step, end_time * step / n_steps);
+        }
+      progress.finish(n_steps, end_time);
+      timing.stop();
+      dealii::TimerOutput::Scope output_timing(scene.timer(), "output");
+      if (csv)
+        csv->flush();
+    }
+
+
+
+    template <int dim>
     void
     Uniaxial<dim>::run()
     {
+      if (variant)
+        return run_variant();
       const Scene<dim> &scene = this->get_scene();
       using State             = Material::BoucWenUniaxial;
 
@@ -187,6 +259,8 @@ namespace hysteron
     {
       std::ostringstream s;
       s << n_steps << " steps";
+      if (variant)
+        return s.str() + ", one implicit update each";
       switch (law.parameters().integrator)
         {
           case Material::BoucWenIntegrator::adaptive:

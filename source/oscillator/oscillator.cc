@@ -175,8 +175,9 @@ namespace hysteron
                           "",
                           Patterns::Anything(),
                           "The storeys' yield forces F_y [N] (in place of the yield stress): one per "
-                          "storey or one for all; needed by a hysteretic Material (bouc-wen), not "
-                          "read with a linear elastic one.");
+                          "storey or one for all; needed by a hysteretic Material (bouc-wen), "
+                          "refused with a linear elastic one and with `Uniaxial law = OpenSees "
+                          "BoucWen` (whose yield deformation is its own).");
         prm.declare_entry("Damping ratio",
                           "0.05",
                           Patterns::Double(),
@@ -207,13 +208,18 @@ namespace hysteron
               "Material/Model",
               "the oscillator's storeys follow the material's uniaxial spring law, which this model "
               "does not offer (bouc-wen and linear elastic do)");
-      if (!law->linear())
+      if (!law->linear() && law->scales_with_yield_value())
         {
           require(!s.get_list("Yield forces").empty(),
                   s.where("Yield forces"),
                   "a hysteretic Material needs the storeys' yield forces");
           yield_force = positive_list(s, "Yield forces", mass.size());
         }
+      else
+        require(s.get_list("Yield forces").empty(),
+                s.where("Yield forces"),
+                "the material's uniaxial law takes no yield force (linear, or OpenSees BoucWen with "
+                "its yield deformation (Ao / (beta + gamma))^(1/n)): leave it empty");
     }
 
 

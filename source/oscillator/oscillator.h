@@ -113,6 +113,12 @@ namespace hysteron
       std::string
       summary() const override;
 
+      bool
+      takes_ground_motion() const override
+      {
+        return true;
+      }
+
     protected:
       void
       parse_parameters(dealii::ParameterHandler &prm) override;

@@ -82,7 +82,7 @@ namespace hysteron
       virgin_state.assign(n * n_state, 0.0);
       if (law)
         for (unsigned int i = 0; i < n; ++i)
-          law->add_spring(stiffness[i], yield_force[i], virgin_state.data() + i * n_state);
+          law->add_spring(stiffness[i], yield_force.empty() ? 0.0 : yield_force[i], virgin_state.data() + i * n_state);
       for (auto *w : {&trial.u, &trial.v, &trial.a, &trial.drift, &trial.force, &tangent, &residual, &diagonal,
                       &increment})
         w->assign(n, 0.0);
@@ -108,9 +108,7 @@ namespace hysteron
     double
     ShearBuilding::hysteretic_variable(const State &s, const unsigned int storey) const
     {
-      return law && law->bouc_wen(storey) ?
-               s.spring_state[storey * n_state + Material::BoucWenUniaxial::z_index] :
-               0.0;
+      return law && n_state > 0 ? law->hysteretic_variable(storey, &s.spring_state[storey * n_state]) : 0.0;
     }
 
 

@@ -50,6 +50,12 @@ namespace hysteron
       std::string
       summary() const override;
 
+      bool
+      takes_ground_motion() const override
+      {
+        return true;
+      }
+
     protected:
       void
       parse_parameters(dealii::ParameterHandler &prm) override;
@@ -171,6 +177,11 @@ namespace hysteron
                   "Material/Model",
                   "inelastic spectra need a hysteretic uniaxial law (e.g. bouc-wen); the material's "
                   "is linear or missing");
+          require(law->scales_with_yield_value(),
+                  "Material/Bouc-Wen/Uniaxial law",
+                  "inelastic spectra set the oscillator's yield force; this law has a yield "
+                  "deformation of its own (OpenSees BoucWen: (Ao / (beta + gamma))^(1/n)) and "
+                  "ignores it: use OpenSees BoucWenOriginal, smooth, pinching or asymmetric");
         }
     }
 

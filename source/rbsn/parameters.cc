@@ -348,12 +348,18 @@ namespace hysteron
                     "the rbsn method's springs follow the uniaxial spring law of the body's "
                     "material, which this material does not offer (e.g. 'bouc-wen' or 'linear "
                     "elastic' do)");
+            require(law->scales_with_yield_value(),
+                    "Body " + bodies[b].name + "/Material",
+                    "the network gives each spring a yield value from its facet, which this "
+                    "uniaxial law ignores (OpenSees BoucWen: its yield deformation is (Ao / (beta "
+                    "+ gamma))^(1/n) for every spring): use a law that scales with it (smooth, "
+                    "pinching, asymmetric, OpenSees BoucWenOriginal)");
             require(analysis != Analysis::variable_order || law->linear() ||
                       law->bouc_wen_parameters(),
                     "RBSN/Analysis",
                     "the variable-order analysis integrates the rates of uniaxial Bouc-Wen springs; "
                     "the springs of the material of body " + bodies[b].name +
-                      " are not Bouc-Wen: use Analysis = implicit dynamics");
+                      " do not follow the smooth Bouc-Wen law: use Analysis = implicit dynamics");
             consistent_tangent = consistent_tangent && spring_law->has_consistent_tangent(m);
             const std::string why = spring_law->unsupported(m);
             require(why.empty(), "RBSN/Spring law", why + " (body " + bodies[b].name + ")");

@@ -376,17 +376,33 @@ namespace hysteron
     effective_parameters_ = "# Parameters of this hysteron " HYSTERON_VERSION " run (" +
                            options.parameter_file + "), defaults included.\n" + text.str();
 
-    // A record that a method would not read must not pass silently.
+    method = Methods::Registry<dim>::create(method_name_, "Method");
+    check_method_inputs(prm);
+    method->initialize(*this, prm);
+  }
+
+  template <int dim>
+  void
+  Scene<dim>::check_method_inputs(dealii::ParameterHandler &prm) const
+  {
+    // A record that the method would not read must not pass silently, nor a material that
+    // a continuum method cannot use.
     {
       Section ground(prm, {"Ground motion"});
-      require(dealii::Utilities::trim(ground.get("File")).empty() || method_name_ == "oscillator" ||
-                method_name_ == "spectrum",
+      require(dealii::Utilities::trim(ground.get("File")).empty() || method->takes_ground_motion(),
               ground.where("File"),
               "the " + method_name_ + " method does not take a ground motion (the oscillator and "
               "spectrum methods do)");
     }
-    method = Methods::Registry<dim>::create(method_name_, "Method");
-    method->initialize(*this, prm);
+    if (method->takes_continuum_materials())
+      for (const auto &b : bodies)
+        if (!b.rigid)
+          {
+            const std::string why = material(b.material, "Body " + b.name + "/Material").continuum_unsupported();
+            require(why.empty(),
+                    material_subsection(b.material),
+                    "the " + method_name_ + " method (Body " + b.name + "): " + why);
+          }
   }
 
   template <int dim>

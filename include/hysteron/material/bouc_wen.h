@@ -2,6 +2,7 @@
 #define hysteron_material_bouc_wen_h
 
 #include <hysteron/material/bouc_wen_constants.h>
+#include <hysteron/material/bouc_wen_family.h>
 #include <hysteron/material/bouc_wen_parameters.h>
 #include <hysteron/material/interface.h>
 
@@ -117,9 +118,20 @@ namespace hysteron
         return parameters;
       }
 
-      /// Uniaxial Bouc-Wen springs (BoucWenUniaxial) with these parameters.
+      /// The springs of `Uniaxial law`: BoucWenUniaxial with these parameters (smooth) or
+      /// a law of the wider family (create_bouc_wen_variant()).
       std::unique_ptr<UniaxialSpringLaw>
       uniaxial_spring_law() const override;
+
+      /// Refuses a continuum use of a `Uniaxial law` other than smooth.
+      std::string
+      continuum_unsupported() const override;
+
+      const BoucWenFamilyParameters &
+      get_family_parameters() const
+      {
+        return family;
+      }
 
     protected:
       void
@@ -137,6 +149,7 @@ namespace hysteron
         const dealii::ArrayView<HoopTangent<dim>>                      &hoop_tangents) const;
 
       BoucWenParameters         parameters;
+      BoucWenFamilyParameters   family;
       BoucWenKernels::Constants constants;
       StressState               stress_state = StressState::three_dimensional;
       bool                      kinematic    = false;

@@ -203,6 +203,15 @@ namespace hysteron
         return nullptr;
       }
 
+      /// Empty if the model can be a continuum's material (update() of strain tensors),
+      /// else why not (a material whose parameters select a law for springs only); the
+      /// scene refuses it for the methods that take continuum materials.
+      virtual std::string
+      continuum_unsupported() const
+      {
+        return "";
+      }
+
       /// Warnings found while reading the parameters (printed by the scene on rank 0).
       const std::vector<std::string> &
       warnings() const

@@ -76,6 +76,25 @@ namespace hysteron
       virtual double
       strain_energy(unsigned int spring, double delta, const double *state) const = 0;
 
+      /// Whether the law uses the springs' yield values (OpenSees' BoucWen does not: its
+      /// yield deformation follows from its own parameters), so that a host which scales
+      /// them (the RBSN's facets, an inelastic spectrum's strength) may use it.
+      virtual bool
+      scales_with_yield_value() const
+      {
+        return true;
+      }
+
+      /// The hysteretic variable z of spring @p spring (in the units of its deformation),
+      /// for output; 0 for a law without one.
+      virtual double
+      hysteretic_variable(unsigned int spring, const double *state) const
+      {
+        (void)spring;
+        (void)state;
+        return 0;
+      }
+
       /// A Bouc-Wen law's parameters (spring laws that are Bouc-Wen by nature, the
       /// coupled interaction surface, ask for them), else null.
       virtual const BoucWenParameters *

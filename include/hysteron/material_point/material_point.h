@@ -46,6 +46,12 @@ namespace hysteron
       std::string
       summary() const override;
 
+      bool
+      takes_continuum_materials() const override
+      {
+        return true;
+      }
+
       /// One row per step (and t = 0): the values written to history.csv.
       const std::vector<std::vector<double>> &
       history() const

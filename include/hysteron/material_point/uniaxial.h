@@ -3,6 +3,7 @@
 
 #include <deal.II/base/function_parser.h>
 
+#include <hysteron/material/bouc_wen_family.h>
 #include <hysteron/material/bouc_wen_uniaxial.h>
 #include <hysteron/scene/method.h>
 #include <hysteron/scene/scene.h>
@@ -61,7 +62,17 @@ namespace hysteron
       parse_parameters(dealii::ParameterHandler &prm) override;
 
     private:
-      Material::BoucWenUniaxial                  law;
+      /// The strain at step @p step (t = End time step / Steps), checked to be finite.
+      double
+      strain_at(unsigned int step) const;
+
+      /// run() with a law of the wider family (`Bouc-Wen/Uniaxial law`, one spring k = E,
+      /// F_y = sigma_y): columns t, eps, sig, z, H1.
+      void
+      run_variant();
+
+      Material::BoucWenUniaxial                   law;
+      std::unique_ptr<Material::UniaxialSpringLaw> variant;
       std::unique_ptr<dealii::FunctionParser<1>> strain;
       double                                     end_time = 1;
       unsigned int                               n_steps  = 1;

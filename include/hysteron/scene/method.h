@@ -73,6 +73,22 @@ namespace hysteron
         return "this method does not write checkpoints";
       }
 
+      /// Whether the method reads `Ground motion/File` (the scene refuses a record that
+      /// a method would ignore).
+      virtual bool
+      takes_ground_motion() const
+      {
+        return false;
+      }
+
+      /// Whether the bodies' materials act as continua (update() of strain tensors): the
+      /// scene then refuses a material whose continuum_unsupported() says why not.
+      virtual bool
+      takes_continuum_materials() const
+      {
+        return false;
+      }
+
       /// Run the scene to the end, writing outputs into the scene's directory.
       virtual void
       run() = 0;

@@ -323,6 +323,12 @@ namespace hysteron
     void
     check_axisymmetry();
 
+    /// Refuse inputs the created method would ignore or cannot use: a ground-motion record
+    /// (Methods::Interface::takes_ground_motion()), a material that is no continuum for a
+    /// continuum method (Material::Interface::continuum_unsupported()).
+    void
+    check_method_inputs(dealii::ParameterHandler &prm) const;
+
     RunOptions                                                      options;
     mutable dealii::ConditionalOStream                              pcout;
     /// Created first and destroyed while a parse error is still caught: a
