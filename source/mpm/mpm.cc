@@ -532,9 +532,11 @@ namespace hysteron
             {
               std::ostringstream m;
               m << "mpm: the time step " << dt << " s is above the critical step " << critical
-                << " s = h / max_p(c_p + |v_p|) (eq. 4.47) times MPM/Maximum CFL number = "
-                << maximum_cfl << (stiffness_damping > 0 ? ", reduced by the stiffness damping" : "")
-                << " at t = " << t << " s (step " << this->n_steps() + 1
+                << " s = h / max_p(c_p + |v_p|) (eq. 4.47"
+                << (stiffness_damping > 0 ? ", times sqrt(1 + xi^2) - xi for MPM/Damping/Rayleigh stiffness "
+                                            "coefficient, xi = a1 max_p(c_p + |v_p|) / h" :
+                                            "")
+                << ") times MPM/Maximum CFL number = " << maximum_cfl << " at t = " << t << " s (step " << this->n_steps() + 1
                 << "): the explicit scheme would be unstable. Use Time/Time step <= "
                 << maximum_cfl * critical << " or 0 (automatic).";
               throw Run::StepFailure(m.str());
