@@ -70,10 +70,19 @@ namespace hysteron
     void
     Solver<dim>::mark_boundary_nodes()
     {
+      // Bit c: a condition sets component c (a wall's normal one too, though it may let go).
+      using Type = typename BoundaryDescription<dim>::Type;
       boundary_node.reset(grid->n_local_nodes(), grid->sparse_box());
       for (const auto &b : boundaries)
-        for (const unsigned int n : b.nodes)
-          boundary_node[n] = 1;
+        for (unsigned int k = 0; k < b.nodes.size(); ++k)
+          for (unsigned int c = 0; c < dim; ++c)
+            {
+              const Type type = static_cast<Type>(b.type);
+              if (type == Type::fixed || (type != Type::velocity && type != Type::displacement ?
+                                            c == b.normal_direction[k] :
+                                            bool(b.components[c])))
+                boundary_node[b.nodes[k]] |= 1u << c;
+            }
     }
 
 
@@ -104,7 +113,7 @@ namespace hysteron
     Solver<dim>::update_damped_nodal_velocities(const double dt)
     {
       // As update_nodal_velocities(), with NodalDamping::velocity_change(); the damping
-      // work of the owned nodes (each shared node once) whose velocity no boundary
+      // work of the owned nodes (each shared node once), of the components no boundary
       // condition or rigid body sets (there the reaction takes the damping force).
       constexpr unsigned int C    = 1 + 2 * dim;
       double *const          node = grid->data().data();
@@ -120,13 +129,13 @@ namespace hysteron
               continue;
             }
           const double inv_m = 1.0 / r[0];
-          const bool   counted = grid->is_owned(n) && !boundary_node[n] && rigid_node_body[n] == 0;
+          const unsigned int held = grid->is_owned(n) && rigid_node_body[n] == 0 ? boundary_node[n] : ~0u;
           for (unsigned int d = 0; d < dim; ++d)
             {
               const double v  = nodes_hold_momenta ? r[1 + d] * inv_m : r[1 + d];
               const double f  = r[1 + dim + d];
               const double dv = nodal_damping.velocity_change(inv_m, v, f, dt);
-              if (counted)
+              if (!(held & (1u << d)))
                 work += nodal_damping.work(r[0], v, f, dv, dt);
               r[1 + dim + d] = dv;
               r[1 + d]       = v + dv;

@@ -389,7 +389,8 @@ namespace hysteron
       bool                          layer_holds_momenta = true;
       /// Whether the layer holds the momenta of particles_to_grid() (not yet converted).
       bool                          layer_from_points = true;
-      /// Per local node: is it a node of a boundary condition (with contact or damping).
+      /// Per local node (with contact or damping): bit c set if a boundary condition sets
+      /// velocity component c there (0: no condition).
       ZeroPages<unsigned char>      boundary_node;
       /// Mark the nodes of the boundary conditions in boundary_node.
       void
