@@ -165,15 +165,17 @@ namespace hysteron
       const auto            &state   = updated_stresses ? particles.next : particles.current;
       const Tensor<1, dim>   gravity = this->get_scene().gravity();
 
-      // Viscous: a1 lambda and a1 mu of the group's elasticity (C0 = lambda I (x) I + 2 mu S).
+      // Viscous: the strain rates come from the nodal velocities (not momenta).
       Assert(!viscous || !nodes_hold_momenta, dealii::ExcInternalError());
       double viscous_work = 0;
       for (const auto &group : particles.groups)
         if (group.material != nullptr)
           {
-            Support      support;
-            const double a1_lambda = viscous ? stiffness_damping * group.material->elasticity().effective_lambda() : 0;
-            const double a1_mu     = viscous ? stiffness_damping * group.material->elasticity().shear_modulus() : 0;
+            Support support;
+            // a1 lambda and a1 mu of the group's elasticity: C0 = lambda I (x) I + 2 mu S.
+            const auto  &elasticity = group.material->elasticity();
+            const double a1_lambda  = viscous ? stiffness_damping * elasticity.effective_lambda() : 0;
+            const double a1_mu      = viscous ? stiffness_damping * elasticity.shear_modulus() : 0;
             for (unsigned int p = group.begin; p < group.end; ++p)
               {
                 support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
@@ -205,7 +207,8 @@ namespace hysteron
                 });
               }
           }
-      damping_work += step_dt * viscous_work;
+      if constexpr (viscous)
+        damping_work += step_dt * viscous_work;
       grid->exchange(1 + dim, dim);
       if constexpr (with_contact)
         grid->exchange_layer(1 + dim, dim);
