@@ -133,6 +133,12 @@ namespace hysteron
     {
       ar.section("mpm rank", format);
       ar &internal_work &external_work &boundary_work &max_speed &reactions &n_changed_cells;
+      if (damped())
+        {
+          // Only a damped run has this section (undamped checkpoints keep their format).
+          ar.section("mpm damping", format);
+          ar &damping_work;
+        }
     }
 
 
@@ -353,7 +359,7 @@ namespace hysteron
         {
           Run::sum_rank_parts(rank_parts, this->get_scene().is_root(),
                               [this](CheckpointReader &part) { serialize_rank(part); },
-                              internal_work, external_work, boundary_work, reactions);
+                              internal_work, external_work, boundary_work, reactions, damping_work);
           n_changed_cells = 0;
         }
       restore_points(directory.same_ranks());

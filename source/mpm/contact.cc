@@ -95,10 +95,7 @@ namespace hysteron
     Solver<dim>::setup_contact()
     {
       grid->initialize_layer(n_contact_blocks, contact_block);
-      contact_boundary_node.reset(grid->n_local_nodes(), grid->sparse_box());
-      for (const auto &b : boundaries)
-        for (const unsigned int n : b.nodes)
-          contact_boundary_node[n] = 1;
+      mark_boundary_nodes();
       contact_velocity.assign(n_contact_blocks, dealii::Tensor<1, dim>());
       contact_rigid_velocity.assign(n_contact_blocks, dealii::Tensor<1, dim>());
     }
@@ -265,7 +262,8 @@ namespace hysteron
       /**
        * The trial velocity v_b of each deformable body at a node with two or more bodies:
        * p_b / m_b (or the velocity the layer holds, if not @p holds_momenta), plus
-       * dt f_b / m_b after the momentum balance (@p record). At the first conversion of
+       * dt f_b / m_b after the momentum balance (@p record; with @p damping's nodal
+       * terms on the body's own force and velocity). At the first conversion of
        * the layer the velocity projected from the points is kept, for the FLIP increment
        * Delta v_b = v_b' - p_b / m_b (a correction at the step's start, USF, belongs to
        * it too).
@@ -279,6 +277,7 @@ namespace hysteron
                        const bool                                first_conversion,
                        const double                              dt,
                        const bool                                record,
+                       const NodalDamping                       &damping,
                        std::vector<dealii::Tensor<1, dim>>      &v)
       {
         NodeTotals<dim> total;
@@ -301,7 +300,12 @@ namespace hysteron
                 const double v0 = holds_momenta ? q[1 + d] * inv_m : q[1 + d];
                 if (first_conversion)
                   q[1 + 3 * dim + d] = v0;
-                v[b][d] = record ? v0 + dt * q[1 + dim + d] * inv_m : v0;
+                if (!record)
+                  v[b][d] = v0;
+                else if (damping.active()) // the body's own damped momentum balance
+                  v[b][d] = v0 + damping.velocity_change(inv_m, v0, q[1 + dim + d], dt);
+                else
+                  v[b][d] = v0 + dt * q[1 + dim + d] * inv_m;
               }
             total.mass += q[0];
             total.momentum += q[0] * v[b];
@@ -347,7 +351,7 @@ namespace hysteron
 
           // Two or more bodies: each deformable one's trial velocity.
           const NodeTotals<dim> total =
-            trial_velocities(node, bodies, tiny, layer_holds_momenta, first_conversion, dt, record, v);
+            trial_velocities(node, bodies, tiny, layer_holds_momenta, first_conversion, dt, record, nodal_damping, v);
           if (!(total.mass > tiny))
             continue;
 
@@ -355,7 +359,7 @@ namespace hysteron
           // the deformable bodies at the node: on a boundary node every body is shifted
           // by the change they made there.
           Tensor<1, dim> shift;
-          if (contact_boundary_node[n] && r[0] > tiny)
+          if (boundary_node[n] && r[0] > tiny)
             for (unsigned int d = 0; d < dim; ++d)
               shift[d] = r[1 + d] - total.momentum[d] / total.mass;
           // The velocity the bodies are measured against: a rigid body's (it does not

@@ -166,6 +166,7 @@ namespace hysteron
                           Patterns::Double(),
                           "A fixed `Time/Time step` larger than this multiple of the critical "
                           "step h / max_p(c_p + |v_p|) (eq. 4.47) stops the run, > 0.");
+        declare_damping_parameters(prm);
         prm.enter_subsection("Contact");
         {
           prm.declare_entry("Enable",
@@ -261,6 +262,7 @@ namespace hysteron
       }
 
       parse_contact(prm);
+      parse_damping(prm);
 
       // The scene's bodies must lie in the grid.
       const auto &bodies = scene.body_descriptions();
@@ -331,18 +333,6 @@ namespace hysteron
                       "Boundary with Type = roller and Faces = x- (v_r = 0 on the axis)");
             }
         }
-    }
-
-
-
-    template <int dim>
-    double
-    Solver<dim>::critical_time_step() const
-    {
-      const double speed = grid->is_parallel() ?
-                             dealii::Utilities::MPI::max(max_speed, grid->mpi_communicator()) :
-                             max_speed;
-      return speed > 0 ? grid->lattice().min_h() / speed : std::numeric_limits<double>::max();
     }
 
 
@@ -467,6 +457,8 @@ namespace hysteron
       m_min      = dealii::Utilities::MPI::min(m_min, scene.mpi_communicator());
       small_mass = 1e-12 * m_min;
       // The basis and contact are chosen once: the phase kernels are templates of them.
+      if (nodal_damping.active() && !contact)
+        mark_boundary_nodes();
       if (contact)
         {
           setup_contact();
@@ -482,6 +474,7 @@ namespace hysteron
         scene.console() << (d ? " x " : "") << n_cells[d];
       scene.console() << " cells (h = " << cell_size << " m), " << basis_name << " basis"
                       << (contact ? ", contact between bodies" : "")
+                      << (damped() ? ", damping (MPM/Damping)" : "")
                       << (grid_motion == GridMotion::follow ?
                             ", the grid follows the bodies" :
                             grid_motion == GridMotion::prescribed ? ", the grid moves as prescribed" : "")
@@ -513,7 +506,7 @@ namespace hysteron
     void
     Solver<dim>::initialize()
     {
-      internal_work = external_work = boundary_work = 0;
+      internal_work = external_work = boundary_work = damping_work = 0;
       initial_kinetic_energy = 0;
       for (const auto &group : particles.groups)
         if (group.material != nullptr)
@@ -539,8 +532,11 @@ namespace hysteron
             {
               std::ostringstream m;
               m << "mpm: the time step " << dt << " s is above the critical step " << critical
-                << " s = h / max_p(c_p + |v_p|) (eq. 4.47) times MPM/Maximum CFL number = "
-                << maximum_cfl << " at t = " << t << " s (step " << this->n_steps() + 1
+                << " s = h / max_p(c_p + |v_p|) (eq. 4.47"
+                << (stiffness_damping > 0 ? ", times sqrt(1 + xi^2) - xi for MPM/Damping/Rayleigh stiffness "
+                                            "coefficient, xi = a1 max_p(c_p + |v_p|) / h" :
+                                            "")
+                << ") times MPM/Maximum CFL number = " << maximum_cfl << " at t = " << t << " s (step " << this->n_steps() + 1
                 << "): the explicit scheme would be unstable. Use Time/Time step <= "
                 << maximum_cfl * critical << " or 0 (automatic).";
               throw Run::StepFailure(m.str());
@@ -558,16 +554,18 @@ namespace hysteron
     Solver<dim>::advance(double &t, const double dt)
     {
       // The work sums and reactions of the state t: a failed step leaves them so.
-      const std::array<double, 3> work_at_t{{internal_work, external_work, boundary_work}};
+      const std::array<double, 4> work_at_t{{internal_work, external_work, boundary_work, damping_work}};
       reactions_at_t = reactions; // a member: no allocation per step
       const auto fail_at_t = [&](const std::string &what) {
         internal_work = work_at_t[0];
         external_work = work_at_t[1];
         boundary_work = work_at_t[2];
+        damping_work  = work_at_t[3];
         reactions     = reactions_at_t;
         throw Run::StepFailure(what);
       };
       begin_step(t);
+      step_dt = dt; // the step's dt (the viscous work, the failure message)
       update_scheme->step(*phases, t, dt);
       // A moving grid: where it is after the step (collective, so before any decision).
       Lattice<dim> moved;

@@ -29,6 +29,44 @@ namespace hysteron
     class PhaseKernels;
 
     /**
+     * The nodal part of `MPM/Damping` (doc/mpm.md, "Damping"): mass-proportional
+     * Rayleigh damping -a0 m_i v_i and Cundall's local damping -alpha |f_i| sgn(v_i),
+     * per component, in the momentum balance of a node.
+     */
+    struct NodalDamping
+    {
+      double mass  = 0; ///< a0 [1/s]
+      double local = 0; ///< alpha [-]
+
+      bool
+      active() const
+      {
+        return mass > 0 || local > 0;
+      }
+
+      /**
+       * The velocity change over @p dt of one component of a node with 1 / m = @p inv_m,
+       * velocity @p v and force @p f, from m (v' - v) / dt = f - alpha |f| sgn(v) - a0 m
+       * (v + v') / 2 (the mass term trapezoidal: exact decay to O((a0 dt)^3), any a0 dt stable).
+       */
+      double
+      velocity_change(const double inv_m, const double v, const double f, const double dt) const
+      {
+        const double f_local = f - local * std::abs(f) * ((v > 0) - (v < 0));
+        return dt * (f_local * inv_m - mass * v) / (1.0 + 0.5 * mass * dt);
+      }
+
+      /// The work the damping forces of velocity_change() take out over @p dt (mass @p m,
+      /// change @p dv): dt v_mid (alpha |f| sgn(v) + a0 m v_mid), v_mid = v + dv / 2.
+      double
+      work(const double m, const double v, const double f, const double dv, const double dt) const
+      {
+        const double v_mid = v + 0.5 * dv;
+        return dt * v_mid * (local * std::abs(f) * ((v > 0) - (v < 0)) + mass * m * v_mid);
+      }
+    };
+
+    /**
      * The explicit Material Point Method (`set Method = mpm`), dissertation
      * chapter 4: bodies filled with material points that carry mass, velocity,
      * stress and the Bouc–Wen state; a fixed Cartesian background grid on which
@@ -263,6 +301,7 @@ namespace hysteron
                           const dealii::ArrayView<const double>  &properties);
       void
       locate_probes();
+      /// h / max_p(c_p + |v_p|), reduced for stiffness-proportional damping (damping.cc).
       double
       critical_time_step() const;
       void
@@ -298,13 +337,35 @@ namespace hysteron
       template <typename Basis, bool with_forces, bool with_contact>
       void
       particles_to_grid();
-      template <typename Basis, bool with_contact>
+      /// With @p viscous also the viscous stress a1 C0 : sym(L_p), L_p from the velocities
+      /// the nodes hold (damping.cc), and its work.
+      template <typename Basis, bool with_contact, bool viscous>
       void
       forces_to_grid(const bool updated_stresses);
       void
       nodal_velocities();
       void
       update_nodal_velocities(const double dt);
+      /// update_nodal_velocities() with the nodal damping, and its work (damping.cc).
+      void
+      update_damped_nodal_velocities(const double dt);
+
+      // Damping (`MPM/Damping`, damping.cc; doc/mpm.md, "Damping").
+      NodalDamping nodal_damping;
+      /// Rayleigh stiffness coefficient a1 [s]: the viscous stress a1 C0 : d in the forces.
+      double       stiffness_damping = 0;
+      /// The work of the damping forces (this rank: its points' viscous stresses and its
+      /// owned nodes' forces), the damping_work column of energy.csv.
+      double       damping_work = 0;
+      bool
+      damped() const
+      {
+        return nodal_damping.active() || stiffness_damping > 0;
+      }
+      static void
+      declare_damping_parameters(dealii::ParameterHandler &prm);
+      void
+      parse_damping(dealii::ParameterHandler &prm);
       template <typename Basis, bool with_contact>
       bool
       grid_to_particles(const double t, const double dt);
@@ -334,8 +395,12 @@ namespace hysteron
       bool                          layer_holds_momenta = true;
       /// Whether the layer holds the momenta of particles_to_grid() (not yet converted).
       bool                          layer_from_points = true;
-      /// Per local node: is it a node of a boundary condition (contact only).
-      ZeroPages<unsigned char>      contact_boundary_node;
+      /// Per local node (with contact or damping): bit c set if a boundary condition sets
+      /// velocity component c there (0: no condition).
+      ZeroPages<unsigned char>      boundary_node;
+      /// Mark the nodes of the boundary conditions in boundary_node.
+      void
+      mark_boundary_nodes();
       /// Scratch of apply_contact(): per body, the trial and the rigid velocities.
       std::vector<dealii::Tensor<1, dim>> contact_velocity, contact_rigid_velocity;
       /// Allocate the layer and the scratch of contact (after setup_boundaries()).

@@ -18,7 +18,8 @@ namespace hysteron
       tables.open(this->get_scene(),
                   this->output_directory(),
                   PointData::columns<dim>(state_names, this->get_scene().output_control().additional_columns),
-                  this->run_record());
+                  this->run_record(),
+                  damped());
     }
 
 
@@ -147,7 +148,14 @@ namespace hysteron
       for (unsigned int b = 0; b < bodies.size(); ++b)
         if (bodies[b].rigid)
           r.push_back(reactions[boundaries.size() + b]);
-      tables.write(t, rows, averages, {{kinetic, strain_energy, internal_work, external_work, boundary_work}}, r, comm);
+      tables.write(t,
+                   rows,
+                   averages,
+                   {{kinetic, strain_energy, internal_work, external_work, boundary_work}},
+                   r,
+                   comm,
+                   {},
+                   damping_work);
     }
 
 

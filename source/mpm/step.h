@@ -6,6 +6,7 @@
 // source/mpm/step_*.cc, which instantiate make_step_phases<dim, Basis>.
 
 #include "mpm/mpm.h"
+#include "mpm/support.h"
 
 #include <cmath>
 #include <cstring>
@@ -14,98 +15,6 @@ namespace hysteron
 {
   namespace MPM
   {
-    namespace internal
-    {
-      /**
-       * The tensor-product support of one point: the 1D values and derivatives
-       * per direction and the local grid node of the first support node. The
-       * node of entry (a, b, c) is base + a + b s1 + c s2.
-       */
-      template <int dim, typename Basis>
-      struct Support
-      {
-        static constexpr unsigned int n1 = Basis::n_support;
-        double                        w[dim][n1];
-        double                        g[dim][n1];
-        unsigned int                  base;
-
-        DEAL_II_ALWAYS_INLINE inline void
-        reinit(const Lattice<dim>            &lattice,
-               const BackgroundGrid<dim>     &grid,
-               const dealii::Point<dim>      &x,
-               const std::array<double, dim> &inv_h)
-        {
-          base = 0;
-          for (unsigned int d = 0; d < dim; ++d)
-            {
-              int first;
-              Basis::evaluate((x[d] - lattice.origin[d]) * inv_h[d],
-                              lattice.n_cells[d],
-                              first,
-                              w[d],
-                              g[d]);
-              for (unsigned int k = 0; k < n1; ++k)
-                g[d][k] *= inv_h[d];
-              base += (first - grid.box_lower(d)) * grid.stride(d);
-            }
-        }
-
-        /// Call f(node, N, grad N) for every support node.
-        template <typename Function>
-        DEAL_II_ALWAYS_INLINE inline void
-        for_each(const unsigned int s1, const unsigned int s2, const Function &f) const
-        {
-          dealii::Tensor<1, dim> grad;
-          if constexpr (dim == 2)
-            {
-              for (unsigned int b = 0; b < n1; ++b)
-                for (unsigned int a = 0; a < n1; ++a)
-                  {
-                    grad[0] = g[0][a] * w[1][b];
-                    grad[1] = w[0][a] * g[1][b];
-                    f(base + a + b * s1, w[0][a] * w[1][b], grad);
-                  }
-            }
-          else
-            {
-              (void)s2;
-              for (unsigned int c = 0; c < n1; ++c)
-                for (unsigned int b = 0; b < n1; ++b)
-                  {
-                    const double wbc = w[1][b] * w[2][c];
-                    for (unsigned int a = 0; a < n1; ++a)
-                      {
-                        grad[0] = g[0][a] * wbc;
-                        grad[1] = w[0][a] * g[1][b] * w[2][c];
-                        grad[2] = w[0][a] * w[1][b] * g[2][c];
-                        f(base + a + b * s1 + c * s2, w[0][a] * wbc, grad);
-                      }
-                  }
-            }
-        }
-      };
-
-      /// The lattice and the node strides the kernels need, read once per phase.
-      template <int dim>
-      struct GridGeometry
-      {
-        explicit GridGeometry(const BackgroundGrid<dim> &grid)
-          : lattice(grid.lattice())
-          , s1(grid.stride(1))
-          , s2(dim == 3 ? grid.stride(dim - 1) : 0)
-        {
-          for (unsigned int d = 0; d < dim; ++d)
-            inv_h[d] = 1.0 / lattice.h[d];
-        }
-
-        const Lattice<dim>     &lattice;
-        std::array<double, dim> inv_h;
-        const unsigned int      s1, s2;
-      };
-    } // namespace internal
-
-
-
     template <int dim>
     template <typename Basis, bool with_forces, bool with_contact>
     void
@@ -239,7 +148,7 @@ namespace hysteron
 
 
     template <int dim>
-    template <typename Basis, bool with_contact>
+    template <typename Basis, bool with_contact, bool viscous>
     void
     Solver<dim>::forces_to_grid(const bool updated_stresses)
     {
@@ -256,10 +165,17 @@ namespace hysteron
       const auto            &state   = updated_stresses ? particles.next : particles.current;
       const Tensor<1, dim>   gravity = this->get_scene().gravity();
 
+      // Viscous: the strain rates come from the nodal velocities (not momenta).
+      Assert(!viscous || !nodes_hold_momenta, dealii::ExcInternalError());
+      double viscous_work = 0;
       for (const auto &group : particles.groups)
         if (group.material != nullptr)
           {
             Support support;
+            // a1 lambda and a1 mu of the group's elasticity: C0 = lambda I (x) I + 2 mu S.
+            const auto  &elasticity = group.material->elasticity();
+            const double a1_lambda  = viscous ? stiffness_damping * elasticity.effective_lambda() : 0;
+            const double a1_mu      = viscous ? stiffness_damping * elasticity.shear_modulus() : 0;
             for (unsigned int p = group.begin; p < group.end; ++p)
               {
                 support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
@@ -268,7 +184,16 @@ namespace hysteron
                   particles.load_factor[p] * load_per_point[particles.load[p]];
                 if (dim == 2 && axisymmetric)
                   f_ext[0] -= hoop_force(group, p, state);
-                const SymmetricTensor<2, dim> vs = state.volume[p] * state.stress[p];
+                SymmetricTensor<2, dim> vs = state.volume[p] * state.stress[p];
+                if constexpr (viscous)
+                  {
+                    // sigma_v = a1 C0 : d, d = sym(sum_i v_i (x) grad N_ip); its power V sigma_v : d.
+                    const SymmetricTensor<2, dim> d = internal::strain_rate(support, g, node);
+                    const SymmetricTensor<2, dim> s_v =
+                      a1_lambda * trace(d) * unit_symmetric_tensor<dim>() + 2.0 * a1_mu * d;
+                    vs += state.volume[p] * s_v;
+                    viscous_work += state.volume[p] * (s_v * d);
+                  }
                 double *const                 block =
                   with_contact ? layer + std::size_t(particles.body[p]) * K : nullptr;
                 support.for_each(g.s1, g.s2, [&](const unsigned int n, const double N, const Tensor<1, dim> &grad) {
@@ -282,6 +207,8 @@ namespace hysteron
                 });
               }
           }
+      if constexpr (viscous)
+        damping_work += step_dt * viscous_work;
       grid->exchange(1 + dim, dim);
       if constexpr (with_contact)
         grid->exchange_layer(1 + dim, dim);
@@ -595,7 +522,15 @@ namespace hysteron
       void
       particles_to_grid(const bool forces) override
       {
-        if (forces)
+        if (forces && solver.stiffness_damping > 0)
+          {
+            // The viscous stress needs the nodal velocities of the step's start: the
+            // masses and momenta first, then the forces (the nodes hold velocities).
+            solver.template particles_to_grid<Basis, false, with_contact>();
+            solver.nodal_velocities();
+            solver.template forces_to_grid<Basis, with_contact, true>(false);
+          }
+        else if (forces)
           solver.template particles_to_grid<Basis, true, with_contact>();
         else
           solver.template particles_to_grid<Basis, false, with_contact>();
@@ -604,7 +539,11 @@ namespace hysteron
       void
       forces_to_grid(const typename StepPhases<dim>::Stress stress) override
       {
-        solver.template forces_to_grid<Basis, with_contact>(stress == StepPhases<dim>::Stress::updated);
+        const bool updated = stress == StepPhases<dim>::Stress::updated;
+        if (solver.stiffness_damping > 0)
+          solver.template forces_to_grid<Basis, with_contact, true>(updated);
+        else
+          solver.template forces_to_grid<Basis, with_contact, false>(updated);
       }
 
       void

@@ -106,16 +106,19 @@ namespace hysteron
 
 
     std::vector<std::string>
-    energy_columns()
+    energy_columns(const bool damping_work)
     {
-      return {"time",
-              "kinetic",
-              "strain_energy",
-              "internal_work",
-              "dissipated",
-              "external_work",
-              "boundary_work",
-              "balance"};
+      std::vector<std::string> c{"time",
+                                 "kinetic",
+                                 "strain_energy",
+                                 "internal_work",
+                                 "dissipated",
+                                 "external_work",
+                                 "boundary_work",
+                                 "balance"};
+      if (damping_work)
+        c.insert(c.end() - 1, "damping_work");
+      return c;
     }
 
 
@@ -126,7 +129,8 @@ namespace hysteron
                    const double strain_energy,
                    const double internal_work,
                    const double external_work,
-                   const double boundary_work)
+                   const double boundary_work,
+                   const double damping_work)
     {
       if (!started)
         {
@@ -141,7 +145,7 @@ namespace hysteron
               internal_work - strain_energy + initial_strain,
               external_work,
               boundary_work,
-              kinetic - initial_kinetic + internal_work - external_work - boundary_work};
+              kinetic - initial_kinetic + internal_work - external_work - boundary_work + damping_work};
     }
 
 

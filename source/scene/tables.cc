@@ -19,9 +19,11 @@ namespace hysteron
     Tables<dim>::open(const Scene<dim>               &scene,
                       const std::string              &directory,
                       const std::vector<std::string> &point,
-                      Output::RunRecord              &run_record)
+                      Output::RunRecord              &run_record,
+                      const bool                      with_damping_work)
     {
       record           = &run_record;
+      damping_column   = with_damping_work;
       n_values         = point.size();
       point_names      = point;
       reaction_names   = reaction_columns(scene);
@@ -45,7 +47,7 @@ namespace hysteron
           average_tables.push_back(
             std::make_unique<Output::TimeTable>(file("average_" + std::to_string(i) + ".csv"), c, run_record));
         }
-      energy_table   = std::make_unique<Output::TimeTable>(file("energy.csv"), energy_columns(), run_record);
+      energy_table   = std::make_unique<Output::TimeTable>(file("energy.csv"), energy_columns(damping_column), run_record);
       reaction_table =
         std::make_unique<Output::TimeTable>(file("reactions.csv"), reaction_columns(scene), run_record);
       std::vector<std::string> c{"time"};
@@ -146,7 +148,8 @@ namespace hysteron
                        std::array<double, 5>               energies,
                        std::vector<dealii::Tensor<1, dim>> reactions,
                        const MPI_Comm                      comm,
-                       std::vector<double>                 histories)
+                       std::vector<double>                 histories,
+                       double                              damping_work)
     {
       const unsigned int n_history = 3 * dim;
       AssertThrow(histories.size() == history_names.size() * n_history,
@@ -166,6 +169,7 @@ namespace hysteron
             for (unsigned int d = 0; d < dim; ++d)
               all.push_back(r[d]);
           all.insert(all.end(), histories.begin(), histories.end());
+          all.push_back(damping_work);
           dealii::Utilities::MPI::sum(all, comm, all);
           auto p = all.begin();
           std::copy(p, p + probes.size(), probes.begin());
@@ -178,6 +182,7 @@ namespace hysteron
             for (unsigned int d = 0; d < dim; ++d)
               r[d] = *p++;
           std::copy(p, p + histories.size(), histories.begin());
+          damping_work = p[histories.size()];
         }
       // The rows on every rank (the values are the same after the reduction), so that
       // a non-finite value stops every rank.
@@ -201,9 +206,11 @@ namespace hysteron
           check_finite(t, row, "average_" + std::to_string(i) + ".csv", names);
           average_rows.push_back(std::move(row));
         }
-      const std::vector<double> energy_row =
-        energy_log.row(t, energies[0], energies[1], energies[2], energies[3], energies[4]);
-      check_finite(t, energy_row, "energy.csv", energy_columns());
+      std::vector<double> energy_row =
+        energy_log.row(t, energies[0], energies[1], energies[2], energies[3], energies[4], damping_work);
+      if (damping_column)
+        energy_row.insert(energy_row.end() - 1, damping_work);
+      check_finite(t, energy_row, "energy.csv", energy_columns(damping_column));
       std::vector<double> reaction_row{t};
       for (const auto &r : reactions)
         for (unsigned int d = 0; d < dim; ++d)

@@ -80,15 +80,17 @@ namespace hysteron
                           const dealii::SymmetricTensor<2, dim> &strain,
                           const dealii::ArrayView<const double> &state);
 
-    /// The columns of energy.csv, with `time`.
+    /// The columns of energy.csv, with `time`; with @p damping_work a damping_work
+    /// column before `balance`.
     std::vector<std::string>
-    energy_columns();
+    energy_columns(bool damping_work = false);
 
     /**
      * One row of energy.csv from the sums over the whole model at time t:
      * dissipated = internal work - (strain energy - initial strain energy),
      * balance = kinetic - initial kinetic + internal work - external work -
-     * boundary work (zero for an exact scheme). The first row sets the initial values.
+     * boundary work + damping work (zero for an exact scheme; the damping work is
+     * that of a method's damping forces, 0 without). The first row sets the initial values.
      */
     class EnergyLog
     {
@@ -99,7 +101,8 @@ namespace hysteron
           double strain_energy,
           double internal_work,
           double external_work,
-          double boundary_work);
+          double boundary_work,
+          double damping_work = 0);
 
       /// The reference state (t = 0), for a checkpoint.
       std::array<double, 3>

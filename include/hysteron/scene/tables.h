@@ -37,7 +37,8 @@ namespace hysteron
       open(const Scene<dim>               &scene,
            const std::string              &directory,
            const std::vector<std::string> &point_columns,
-           Output::RunRecord              &record);
+           Output::RunRecord              &record,
+           const bool                      with_damping_work = false);
 
       /// The number of values of a point (the probe columns without `time`).
       unsigned int
@@ -56,7 +57,9 @@ namespace hysteron
        * history set, history_columns(): the mean displacement, the reaction and
        * the load, each dim values; empty without history sets). The arrays are
        * summed in place. A second row at the time of the last one is not written
-       * (every rank skips it, before the reduction). A NaN or infinite value is
+       * (every rank skips it, before the reduction). @p damping_work (this rank's part)
+       * is the damping_work column of a table opened with_damping_work (and enters the
+       * balance). A NaN or infinite value is
        * never written: every rank throws RuntimeError naming the table, the column
        * and the time (the tables keep every row before).
        */
@@ -67,7 +70,8 @@ namespace hysteron
             std::array<double, 5>                energies,
             std::vector<dealii::Tensor<1, dim>>  reactions,
             const MPI_Comm                       comm,
-            std::vector<double>                  histories = {});
+            std::vector<double>                  histories    = {},
+            double                               damping_work = 0);
 
       /// The columns of history_<set>.csv after `time`: u_x, u_y(, u_z), reaction_x, ...,
       /// load_x, ...
@@ -103,6 +107,7 @@ namespace hysteron
       std::vector<std::vector<std::pair<double, double>>> history_ranges;
       EnergyLog                                       energy_log;
       unsigned int                                    n_values = 0;
+      bool                                            damping_column = false; ///< of open()
       std::vector<std::string>                        point_names, reaction_names;
 
       /// Throw RuntimeError if a value of @p row (of @p table, columns @p names) is not finite.
