@@ -429,12 +429,17 @@ namespace hysteron
       // input), long before the values overflow: the unstable mode grows by
       // a factor of 1.9 per step at 1.05 times the critical step (3.5 at 1.2 times), and the
       // strain energy reaches inf while u is still finite. (The internal work is the one up
-      // to t: commit() adds this step's.)
+      // to t: commit() adds this step's. The external work has this step's, which a load
+      // that rises from 0 needs: its work up to t can be less than half the kinetic energy at
+      // t + dt in the first steps.)
       {
-        double kinetic = 0;
+        double kinetic = 0, external = external_work;
         for (const auto i : owned_dofs)
-          kinetic += 0.5 * lumped_mass(i) * v_new(i) * v_new(i);
-        std::array<double, 5> sums{{kinetic, external_work, boundary_work + step_work, k0, internal_work}};
+          {
+            kinetic += 0.5 * lumped_mass(i) * v_new(i) * v_new(i);
+            external += 0.5 * (f_ext_old(i) + f_ext(i)) * (u_trial(i) - u(i));
+          }
+        std::array<double, 5> sums{{kinetic, external, boundary_work + step_work, k0, internal_work}};
         if (dealii::Utilities::MPI::n_mpi_processes(comm) > 1)
           dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(sums.data(), sums.size()),
                                       comm,
