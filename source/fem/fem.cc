@@ -483,7 +483,8 @@ namespace hysteron
             {
               std::ostringstream m;
               m << "fem: the time step " << nominal << " s is above the critical step "
-                << critical_step << " s = 2 / omega_max of central differences times "
+                << critical_step << " s = 2 / omega_max of central differences"
+                << (absorbers.empty() ? "" : " (lowered by the dashpots of absorbing boundaries)") << " times "
                 << "FEM/Maximum CFL number = " << maximum_cfl
                 << ": the explicit scheme would be unstable. Use a time step <= "
                 << maximum_cfl * critical_step << " s or 0 (automatic).";
