@@ -238,9 +238,18 @@ namespace hysteron
       increment -= u;
       if (analysis == Analysis::implicit_dynamics)
         {
+          // The dashpots of absorbing boundaries do the work -1/2 (C_b v_n + C_b v_n+1) . du on
+          // the body (trapezoidal like the other works, so that Newmark's balance stays exact).
+          Vector dashpot = absorbers.empty() ? Vector() : absorbing_force(v_ghost);
           dynamics.update(increment, dt, v, a);
           v_ghost = v;
           a_ghost = a;
+          if (!absorbers.empty())
+            {
+              dashpot += absorbing_force(v_ghost);
+              for (const auto i : owned_dofs)
+                boundary_work -= 0.5 * dashpot(i) * increment(i);
+            }
         }
       else if (analysis == Analysis::quasi_static && dt > 0)
         {

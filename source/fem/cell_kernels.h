@@ -116,18 +116,19 @@ namespace hysteron
       std::vector<dealii::Tensor<1, dim>>              sG;
     };
 
-    /// The dynamic kernel's scratch: mass and elastic stiffness of the cell, the forces of
+    /// The dynamic kernel's scratch: mass, elastic stiffness and dashpots of the cell, the forces of
     /// the converged state, and the Newmark kinematics of its nodes.
     struct DynamicsScratch
     {
       explicit DynamicsScratch(const unsigned int n)
         : M(n, n)
         , K0(n, n)
+        , Cb(n, n)
       {
         for (auto *x : {&fx0, &fi0, &v0, &a0, &a1, &v1, &Cv0, &Cv1, &tmp})
           x->reinit(n);
       }
-      dealii::FullMatrix<double> M, K0;
+      dealii::FullMatrix<double> M, K0, Cb; ///< Cb: the absorbing boundaries' dashpots
       dealii::Vector<double>     fx0, fi0, v0, a0, a1, v1, Cv0, Cv1, tmp;
     };
 
@@ -145,7 +146,8 @@ namespace hysteron
         , ffv(mapping,
               fe,
               face_quadrature,
-              dealii::update_values | dealii::update_quadrature_points | dealii::update_JxW_values)
+              dealii::update_values | dealii::update_quadrature_points | dealii::update_JxW_values |
+                dealii::update_normal_vectors)
         , du(fe.n_dofs_per_cell())
         , B(quadrature.size(), std::vector<dealii::SymmetricTensor<2, dim>>(fe.n_dofs_per_cell()))
         , material(fe.n_dofs_per_cell())

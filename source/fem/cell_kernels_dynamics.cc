@@ -65,7 +65,8 @@ namespace hysteron
     {
       // r = M a1 + (1 + alpha)(C v1 + f_int(u1) - f_ext(t1)) - alpha (C v0 + f_int(u0) - f_ext(t0)),
       // dr/du1 = M / (beta dt^2) + (1 + alpha) gamma / (beta dt) C + (1 + alpha) K,
-      // with the Newmark a1, v1 of the cell's nodes and C = a0 M + a1 K0.
+      // with the Newmark a1, v1 of the cell's nodes and C = a0 M + a1 K0 + C_b (C_b: the
+      // dashpots of the cell's absorbing faces, absorbing.cc).
       const auto &rayleigh = solver.dynamics;
       auto       &d        = scratch.dynamics;
       const auto &du       = scratch.du;
@@ -90,6 +91,12 @@ namespace hysteron
           d.K0.vmult(d.tmp, d.v1);
           d.Cv1.add(rayleigh.rayleigh_stiffness, d.tmp);
         }
+      const bool absorbing = solver.absorbing_matrix(cell, scratch.ffv, d.Cb);
+      if (absorbing)
+        {
+          d.Cb.vmult(d.Cv0, d.v0, true);
+          d.Cb.vmult(d.Cv1, d.v1, true);
+        }
       for (unsigned int i = 0; i < n; ++i)
         copy.r[i] = copy.Mv[i] + (1 + alpha) * (d.Cv1[i] + copy.fi[i] - copy.fx[i]) -
                     alpha * (d.Cv0[i] + d.fi0[i] - d.fx0[i]);
@@ -100,6 +107,8 @@ namespace hysteron
           for (unsigned int i = 0; i < n; ++i)
             for (unsigned int j = 0; j < n; ++j)
               copy.A(i, j) = (1 + alpha) * copy.A(i, j) + c_M * d.M(i, j) + c_K0 * d.K0(i, j);
+          if (absorbing)
+            copy.A.add((1 + alpha) * gamma / (beta * dt), d.Cb);
         }
       for (unsigned int i = 0; i < n; ++i)
         copy.Mv[i] += d.Cv1[i];

@@ -96,6 +96,12 @@ namespace hysteron
           set.name     = d.name;
           set.boundary = b;
           const int index = dirichlet.size();
+          if (d.type == Type::absorbing)
+            {
+              // Dashpots on faces (setup_absorbing()), not a constraint.
+              dirichlet.push_back(set);
+              continue;
+            }
           if (d.type == Type::wall)
             {
               // Unilateral: handled by the explicit step, not as a constraint.

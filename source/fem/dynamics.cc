@@ -55,10 +55,14 @@ namespace hysteron
     void
     Solver<dim>::damping_force(const Vector &velocity, Vector &force, const double factor) const
     {
-      // force += factor C v, C = a0 M_L + a1 K0 (matrix-free).
+      // force += factor C v, C = a0 M_L + a1 K0 (matrix-free) + the lumped C_b of the
+      // absorbing boundaries.
       if (dynamics.rayleigh_mass > 0)
         for (const auto i : owned_dofs)
           force(i) += factor * dynamics.rayleigh_mass * lumped_mass(i) * velocity(i);
+      if (!absorbers.empty())
+        for (const auto i : owned_dofs)
+          force(i) += factor * absorbing_lumped(i) * velocity(i);
       if (dynamics.rayleigh_stiffness > 0)
         {
           Vector ghost(owned_dofs, relevant_dofs, this->get_scene().mpi_communicator());
@@ -126,7 +130,21 @@ namespace hysteron
           if (it > 20 && change < 1e-7)
             break;
         }
-      return lambda > 0 ? 2.0 / std::sqrt(lambda) : std::numeric_limits<double>::max();
+      if (!(lambda > 0))
+        return std::numeric_limits<double>::max();
+      // Dashpots c_i (lumped C_b) act on the velocity of the half step before, which lowers
+      // the limit: for one DoF, m a + c v + k u = 0 with c = 2 xi m omega, the recursion
+      // z^2 - (2 - W^2 - 2 xi W) z + 1 - 2 xi W = 0 (W = omega dt) has its roots in the unit
+      // disc for W <= 2 (sqrt(1 + xi^2) - xi). Taken with omega_max and the largest c_i / m_i
+      // (a bound: a 1D bar with a dashpot at its end, h / c_p without it, is stable up to
+      // 0.707 h / c_p, the bound gives 0.618 h / c_p).
+      double c_over_m = 0;
+      if (!absorbers.empty())
+        for (const auto i : owned_dofs)
+          c_over_m = std::max(c_over_m, absorbing_lumped(i) / lumped_mass(i));
+      const double omega = std::sqrt(lambda);
+      const double xi    = dealii::Utilities::MPI::max(c_over_m, comm) / (2 * omega);
+      return 2.0 / omega * (std::sqrt(1 + xi * xi) - xi);
     }
 
 
@@ -219,6 +237,13 @@ namespace hysteron
       // a0 from M a0 = f_ext(0) - f_int(0) - C v0 on the free DoFs (prescribed: 0).
       if (analysis == Analysis::explicit_dynamics)
         {
+          if (!absorbers.empty())
+            {
+              Vector one(owned_dofs, comm), ones(owned_dofs, relevant_dofs, comm);
+              one              = 1.0;
+              ones             = one;
+              absorbing_lumped = absorbing_force(ones, true); // the diagonal c_i
+            }
           critical_step = critical_time_step();
           Vector force  = f_ext;
           force -= f_int;
@@ -248,7 +273,7 @@ namespace hysteron
     Solver<dim>::assemble_mass_system()
     {
       // The consistent mass matrix (condensed) and the right-hand side
-      // f_ext(0) - f_int(0) - C v0 of the initial acceleration.
+      // f_ext(0) - f_int(0) - (C + C_b) v0 of the initial acceleration.
       using namespace dealii;
       system_matrix = 0;
       system_rhs    = 0;
@@ -287,6 +312,8 @@ namespace hysteron
           elastic_stiffness_product(v_ghost, Kv);
           force.add(-dynamics.rayleigh_stiffness, Kv);
         }
+      if (!absorbers.empty())
+        force.add(-1.0, absorbing_force(v_ghost));
       for (const auto i : owned_dofs)
         if (!constraints.is_constrained(i))
           system_rhs(i) += force(i);
@@ -351,10 +378,16 @@ namespace hysteron
       u_trial = u;
       u_trial.add(dt, v_half);
 
+      // The boundaries' work of the step: the walls', then the dashpots'.
       std::vector<Tensor<1, dim>> contact(dirichlet.size());
-      const double                wall_work = project_on_walls(dt, v_half, contact);
+      double                      step_work = project_on_walls(dt, v_half, contact);
       u_trial.compress(VectorOperation::insert);
       v_half.compress(VectorOperation::insert);
+      // The dashpots of absorbing boundaries do the work -c_i v_1/2 du_i on the body (their
+      // force -c_i v_1/2 acts over the step): a boundary work, with the walls'.
+      if (!absorbers.empty())
+        for (const auto i : owned_dofs)
+          step_work -= absorbing_lumped(i) * v_half(i) * (u_trial(i) - u(i));
 
       // The members keep the state of t until the step has passed its checks: a failing
       // step writes the tables of t (StepFailure), not a mixture with the failed step (its
@@ -396,19 +429,26 @@ namespace hysteron
       // input), long before the values overflow: the unstable mode grows by
       // a factor of 1.9 per step at 1.05 times the critical step (3.5 at 1.2 times), and the
       // strain energy reaches inf while u is still finite. (The internal work is the one up
-      // to t: commit() adds this step's.)
+      // to t: commit() adds this step's. The external work has this step's, which a load
+      // that rises from 0 needs: its work up to t can be less than half the kinetic energy at
+      // t + dt in the first steps.)
       {
-        double kinetic = 0;
+        double kinetic = 0, external = external_work;
         for (const auto i : owned_dofs)
-          kinetic += 0.5 * lumped_mass(i) * v_new(i) * v_new(i);
-        std::array<double, 5> sums{{kinetic, external_work, boundary_work + wall_work, k0, internal_work}};
+          {
+            kinetic += 0.5 * lumped_mass(i) * v_new(i) * v_new(i);
+            external += 0.5 * (f_ext_old(i) + f_ext(i)) * (u_trial(i) - u(i));
+          }
+        std::array<double, 5> sums{{kinetic, external, boundary_work + step_work, k0, internal_work}};
         if (dealii::Utilities::MPI::n_mpi_processes(comm) > 1)
           dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(sums.data(), sums.size()),
                                       comm,
                                       dealii::ArrayView<double>(sums.data(), sums.size()));
         if (initial_kinetic < 0)
           initial_kinetic = sums[3];
-        const double input = initial_kinetic + std::abs(sums[1]) + std::abs(sums[2]);
+        // Boundary work that takes energy out (walls, the dashpots of absorbing boundaries) is
+        // no input: the dashpots of an unstable run would otherwise absorb ever more of it.
+        const double input = initial_kinetic + std::abs(sums[1]) + std::max(0.0, sums[2]);
         if (energy_diverged(sums[0] + sums[4], input))
           {
             std::ostringstream m;
@@ -417,7 +457,8 @@ namespace hysteron
               << " J is more than twice the energy put in ("
               << input << " J: initial kinetic energy, external and boundary work). The time step "
               << dt << " s is " << dt / critical_step << " times the critical step " << critical_step
-              << " s = 2 / omega_max (FEM/Maximum CFL number = " << maximum_cfl
+              << " s = 2 / omega_max" << (absorbers.empty() ? "" : ", lowered by the absorbing boundaries' dashpots")
+              << " (FEM/Maximum CFL number = " << maximum_cfl
               << "); use a time step <= " << critical_step << " s.";
             fail_step(m.str());
           }
@@ -430,7 +471,7 @@ namespace hysteron
         inertia(i) = lumped_mass(i) * a_new(i) + damping(i);
       inertia.compress(VectorOperation::insert);
       wall_forces = contact;      // this rank's part, like every table value
-      boundary_work += wall_work;
+      boundary_work += step_work;
       commit(t1, dt);
       v_ghost = v;
       a_ghost = a;

@@ -357,6 +357,12 @@ namespace hysteron
                   "Boundary " + b.name + "/Type",
                   "a wall (unilateral contact) needs FEM/Analysis = explicit dynamics; "
                   "implicit analyses support fixed, roller, velocity and displacement");
+      for (const auto &b : scene.boundary_descriptions())
+        if (b.type == Type::absorbing)
+          require(analysis != Analysis::quasi_static,
+                  "Boundary " + b.name + "/Type",
+                  "an absorbing boundary is a dashpot on the velocities, which a quasi-static "
+                  "analysis does not have: use FEM/Analysis = implicit dynamics or explicit dynamics");
       if (analysis == Analysis::quasi_static)
         for (const auto &b : bodies)
           require(!b.initial_velocity || b.rigid,
@@ -384,6 +390,7 @@ namespace hysteron
       check_supports();
       warn_about_locking();
       setup_loads();
+      setup_absorbing();
       setup_probes();
       setup_set_histories();
       setup_dynamics();
@@ -476,7 +483,8 @@ namespace hysteron
             {
               std::ostringstream m;
               m << "fem: the time step " << nominal << " s is above the critical step "
-                << critical_step << " s = 2 / omega_max of central differences times "
+                << critical_step << " s = 2 / omega_max of central differences"
+                << (absorbers.empty() ? "" : " (lowered by the dashpots of absorbing boundaries)") << " times "
                 << "FEM/Maximum CFL number = " << maximum_cfl
                 << ": the explicit scheme would be unstable. Use a time step <= "
                 << maximum_cfl * critical_step << " s or 0 (automatic).";

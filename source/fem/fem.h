@@ -7,8 +7,10 @@
 #include <deal.II/distributed/tria_base.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping_q.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
@@ -397,9 +399,26 @@ namespace hysteron
       void
       elastic_stiffness_product(const Vector &x, Vector &y) const;
 
-      /// force += factor C v (Rayleigh damping with the lumped mass, explicit dynamics).
+      /// force += factor C v (Rayleigh damping with the lumped mass and the lumped dashpots
+      /// of absorbing boundaries, explicit dynamics).
       void
       damping_force(const Vector &velocity, Vector &force, const double factor) const;
+
+      // Absorbing boundaries (absorbing.cc): Lysmer-Kuhlemeyer dashpots on boundary faces.
+      /// The faces of every absorbing boundary; refuses one that selects none.
+      void
+      setup_absorbing();
+      /// The dashpots' damping matrix C_b of the locally owned @p cell (its absorbing faces,
+      /// its material); false (C untouched) if it has no absorbing face. @p ffv needs values,
+      /// quadrature points, JxW and normals.
+      bool
+      absorbing_matrix(const typename dealii::DoFHandler<dim>::active_cell_iterator &cell,
+                       dealii::FEFaceValues<dim>                                    &ffv,
+                       dealii::FullMatrix<double>                                   &C) const;
+      /// C_b v for the ghosted @p velocity (owned entries), or, with @p lumped, the row sums
+      /// of C_b over each node's component times v.
+      Vector
+      absorbing_force(const Vector &velocity, const bool lumped = false) const;
 
       /// The prescribed displacement increment of constrained DoF @p k (constrained_list) over [t0, t1].
       double
@@ -550,6 +569,19 @@ namespace hysteron
       std::vector<double>                   wall_reference;  ///< their reference coordinate
       std::vector<unsigned int>             wall_of_dof;
       std::vector<dealii::Tensor<1, dim>>   wall_forces;     ///< per Dirichlet set, last step
+      /// Absorbing boundaries: per condition the Gmsh group of its faces (tag, or -1) or the
+      /// faces of the mesh's bounding box (2 d + side, as BoundaryDescription::faces).
+      struct Absorber
+      {
+        int                       group = -1;
+        std::vector<unsigned int> faces;
+      };
+      std::vector<Absorber>                 absorbers;
+      /// Whether face @p f of @p cell is a boundary face of an absorbing boundary (of @p only).
+      bool
+      absorbs_face(const typename dealii::DoFHandler<dim>::active_cell_iterator &cell,
+                   const unsigned int                                            f,
+                   const Absorber                                               *only = nullptr) const;
 
       // The state: displacement, velocity, acceleration (owned and ghosted), the
       // forces, and the lumped mass of explicit dynamics. f_int, f_ext and inertia are
@@ -557,6 +589,8 @@ namespace hysteron
       // (f_int + inertia - f_ext) those of the converged state, which the output reads.
       Vector u, u_ghost, v, v_ghost, a, a_ghost, u_trial;
       Vector f_int, f_ext, f_int_old, f_ext_old, inertia, lumped_mass, reaction_old;
+      /// Explicit dynamics with absorbing boundaries: the row-sum-lumped (diagonal) C_b.
+      Vector absorbing_lumped;
       /// The vectors of the state (a checkpoint's cell records hold their values).
       std::array<Vector *, 10>
       state_vectors()

@@ -24,6 +24,9 @@ namespace hysteron
       boundaries.clear();
       for (const auto &description : scene.boundary_descriptions())
         {
+          require(description.type != Type::absorbing,
+                  "Boundary " + description.name + "/Type",
+                  "absorbing boundaries are FEM-only for now (Method = fem, a dynamic analysis)");
           BoundaryNodes b;
           b.name       = description.name;
           b.type       = static_cast<unsigned int>(description.type);
@@ -193,6 +196,8 @@ namespace hysteron
                   case Type::wall:
                     // Lower face (sign +1): the body may not move in -d; upper face: not in +d.
                     impose(r, d, bc.normal_sign[k] > 0 ? std::max(r[1 + d], 0.0) : std::min(r[1 + d], 0.0), n, reactions[b]);
+                    break;
+                  case Type::absorbing: // refused by setup_boundaries()
                     break;
                 }
             }

@@ -377,9 +377,14 @@ namespace hysteron
         }
       spring_law->initialize(materials);
       for (const auto &b : scene().boundary_descriptions())
-        require(b.type != BoundaryDescription<dim>::Type::wall,
-                "Boundary " + b.name + "/Type",
-                "the rbsn method has no walls (use fixed, roller, velocity or displacement)");
+        {
+          require(b.type != BoundaryDescription<dim>::Type::wall,
+                  "Boundary " + b.name + "/Type",
+                  "the rbsn method has no walls (use fixed, roller, velocity or displacement)");
+          require(b.type != BoundaryDescription<dim>::Type::absorbing,
+                  "Boundary " + b.name + "/Type",
+                  "absorbing boundaries are FEM-only for now (Method = fem, a dynamic analysis)");
+        }
     }
 
 

@@ -33,6 +33,8 @@ namespace hysteron
           return "wall";
         case Type::velocity:
           return "velocity";
+        case Type::absorbing:
+          return "absorbing";
         default:
           return "displacement";
       }

@@ -199,8 +199,8 @@ namespace hysteron
                                        const dealii::Point<dim> &upper,
                                        const double              tolerance) const
   {
-    if (type == Type::wall)
-      return false;
+    if (type == Type::wall || type == Type::absorbing)
+      return false; // no kinematic constraint
     for (const unsigned int face : faces)
       {
         const unsigned int d = face / 2;
@@ -386,6 +386,7 @@ namespace hysteron
                                  type == "roller"   ? Description::Type::roller :
                                  type == "wall"     ? Description::Type::wall :
                                  type == "velocity" ? Description::Type::velocity :
+                                 type == "absorbing" ? Description::Type::absorbing :
                                                       Description::Type::displacement;
         b.faces      = parse_faces<dim>(s, "Faces");
         b.has_region = !dealii::Utilities::trim(s.get("Region")).empty();
@@ -410,6 +411,11 @@ namespace hysteron
                   s.where(b.set.empty() ? "Region" : "Set"),
                   "roller and wall conditions act on `Faces` (the face gives the normal), "
                   "not on a region or a physical group");
+        if (b.type == Description::Type::absorbing)
+          require(!b.has_region && (!b.faces.empty() || !b.physical_group.empty()),
+                  s.where(b.set.empty() ? "Region" : "Set"),
+                  "an absorbing boundary acts on boundary faces, whose normal it needs: give "
+                  "`Faces` or a `Set` of boundary faces (a Gmsh physical group), not a region");
         b.components.assign(dim, true);
         if (b.type == Description::Type::velocity || b.type == Description::Type::displacement)
           {
