@@ -17,6 +17,7 @@
 #include <hysteron/base/exceptions.h>
 #include "fem/fem.h"
 
+#include <array>
 #include <cmath>
 
 namespace hysteron
@@ -145,8 +146,11 @@ namespace hysteron
     typename Solver<dim>::Vector
     Solver<dim>::absorbing_force(const Vector &velocity, const bool lumped) const
     {
-      // y = C_b v, or with the row-sum-lumped C_b: y_i = (sum_{j, c_j = c_i} C_b,ij) v_i (the
-      // nodal row sums of one component; the coupling n_x n_y of an inclined face drops out).
+      // y = C_b v, or with the lumped C_b: y_i = d_i v_i with the HRZ diagonal of one component
+      // c, d_i = C_b,ii (sum_{k,l in c} C_b,kl) / (sum_{k in c} C_b,kk): positive for every
+      // node, also where a row sum is zero (the vertices of a P2 triangle or quadrilateral face
+      // carry no load of a uniform traction); equal to the row sums on Q1 and P1 faces (the
+      // coupling n_x n_y of an inclined face drops out).
       using namespace dealii;
       Vector             y(owned_dofs, this->get_scene().mpi_communicator());
       const unsigned int n = fe->n_dofs_per_cell();
@@ -164,13 +168,22 @@ namespace hysteron
             for (unsigned int i = 0; i < n; ++i)
               ve[i] = velocity(dofs[i]);
             if (lumped)
-              for (unsigned int i = 0; i < n; ++i)
-                {
-                  ye[i] = 0;
-                  for (unsigned int j = 0; j < n; ++j)
-                    if (fe->system_to_component_index(i).first == fe->system_to_component_index(j).first)
-                      ye[i] += C(i, j) * ve[i];
-                }
+              {
+                std::array<double, dim> total{}, diagonal{};
+                for (unsigned int i = 0; i < n; ++i)
+                  {
+                    const unsigned int c = fe->system_to_component_index(i).first;
+                    diagonal[c] += C(i, i);
+                    for (unsigned int j = 0; j < n; ++j)
+                      if (fe->system_to_component_index(j).first == c)
+                        total[c] += C(i, j);
+                  }
+                for (unsigned int i = 0; i < n; ++i)
+                  {
+                    const unsigned int c = fe->system_to_component_index(i).first;
+                    ye[i] = diagonal[c] > 0 ? C(i, i) * total[c] / diagonal[c] * ve[i] : 0.0;
+                  }
+              }
             else
               C.vmult(ye, ve);
             y.add(dofs, ye);

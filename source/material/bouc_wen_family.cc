@@ -5,6 +5,8 @@
 #include <hysteron/material/bouc_wen_family.h>
 #include <hysteron/material/bouc_wen_uniaxial.h>
 
+#include "material/update_each_spring.h"
+
 #include "material/safeguarded_newton.h"
 
 #include <cmath>
@@ -102,6 +104,29 @@ namespace hysteron
         double k, y;
       };
 
+      /// The force of the laws with a linear and a hysteretic branch in parallel,
+      /// F = alpha k delta + (1 - alpha) k z, its partial derivatives and recoverable energy.
+      struct ParallelBranches
+      {
+        double alpha;
+
+        std::pair<double, double>
+        force(const double delta, const double z, const Spring &s) const
+        {
+          return {alpha * s.k * delta + (1 - alpha) * s.k * z, alpha * s.k};
+        }
+        double
+        force_by_z(const double, const Spring &s) const
+        {
+          return (1 - alpha) * s.k;
+        }
+        double
+        strain_energy(const double delta, const double z, const Spring &s) const
+        {
+          return bouc_wen_strain_energy(alpha, s.k, delta, z);
+        }
+      };
+
       /**
        * OpenSees `BoucWen` (Haukaas), z in the units of delta:
        *   z' = delta' [A - nu |z|^n (gamma + beta sgn(z delta'))] / eta,
@@ -110,9 +135,9 @@ namespace hysteron
        * The saturation value is (A / (nu (beta + gamma)))^(1/n): beta and gamma carry the
        * units of delta^-n and the spring's yield value is not used.
        */
-      struct OpenSeesBoucWen
+      struct OpenSeesBoucWen : ParallelBranches
       {
-        double alpha, n, beta, gamma, A0, dA, dnu, deta;
+        double n, beta, gamma, A0, dA, dnu, deta;
 
         template <typename T>
         T
@@ -126,25 +151,10 @@ namespace hysteron
         {
           return (1 - alpha) * s.k;
         }
-        std::pair<double, double>
-        force(const double delta, const double z, const Spring &s) const
-        {
-          return {alpha * s.k * delta + (1 - alpha) * s.k * z, alpha * s.k};
-        }
-        double
-        force_by_z(const double, const Spring &s) const
-        {
-          return (1 - alpha) * s.k;
-        }
         double
         scale(const double, const Spring &) const
         {
           return std::pow(A0 / (beta + gamma), 1 / n);
-        }
-        double
-        strain_energy(const double delta, const double z, const Spring &s) const
-        {
-          return bouc_wen_strain_energy(alpha, s.k, delta, z);
         }
       };
 
@@ -157,9 +167,9 @@ namespace hysteron
        *   w_u = (A / (nu (beta + gamma)))^(1/n), zeta_1 = zeta_s (1 - exp(-p e)),
        *   zeta_2 = (psi_0 + dpsi e)(lambda + zeta_1).
        */
-      struct Pinching
+      struct Pinching : ParallelBranches
       {
-        double alpha, n, beta, gamma, A0, dA, dnu, deta, zeta_s, p, q, psi0, dpsi, lambda;
+        double n, beta, gamma, A0, dA, dnu, deta, zeta_s, p, q, psi0, dpsi, lambda;
 
         template <typename T>
         T
@@ -182,25 +192,10 @@ namespace hysteron
         {
           return s.k * s.k / (s.y * s.y); // e = int z d delta / z_y^2
         }
-        std::pair<double, double>
-        force(const double delta, const double z, const Spring &s) const
-        {
-          return {alpha * s.k * delta + (1 - alpha) * s.k * z, alpha * s.k};
-        }
-        double
-        force_by_z(const double, const Spring &s) const
-        {
-          return (1 - alpha) * s.k;
-        }
         double
         scale(const double, const Spring &s) const
         {
           return s.y / s.k;
-        }
-        double
-        strain_energy(const double delta, const double z, const Spring &s) const
-        {
-          return bouc_wen_strain_energy(alpha, s.k, delta, z);
         }
       };
 
@@ -211,9 +206,9 @@ namespace hysteron
        *   z_y(z) = y / k for z >= 0, r_c y / k for z < 0;
        * continuous at z = 0, where |z|^n vanishes.
        */
-      struct Asymmetric
+      struct Asymmetric : ParallelBranches
       {
-        double a, n, beta, gamma, ratio;
+        double n, beta, gamma, ratio;
 
         template <typename T>
         T
@@ -228,25 +223,10 @@ namespace hysteron
         {
           return 0;
         }
-        std::pair<double, double>
-        force(const double delta, const double z, const Spring &s) const
-        {
-          return {a * s.k * delta + (1 - a) * s.k * z, a * s.k};
-        }
-        double
-        force_by_z(const double, const Spring &s) const
-        {
-          return (1 - a) * s.k;
-        }
         double
         scale(const double z, const Spring &s) const
         {
           return (z >= 0 ? 1.0 : ratio) * s.y / s.k;
-        }
-        double
-        strain_energy(const double delta, const double z, const Spring &s) const
-        {
-          return bouc_wen_strain_energy(a, s.k, delta, z);
         }
       };
 
@@ -360,20 +340,11 @@ namespace hysteron
                const unsigned int tangent_stride,
                std::string       &failure) const override
         {
-          unsigned int failed = n;
-          for (unsigned int i = 0; i < n; ++i)
-            try
-              {
-                const double dF_dd = advance(springs[first + i], increment[i], force[i], state + 3 * i);
-                if (tangent)
-                  tangent[tangent_stride * i] = dF_dd;
-              }
-            catch (const RuntimeError &error)
-              {
-                failure = error.what();
-                failed  = i;
-              }
-          return failed;
+          return update_each_spring(n, failure, [&](const unsigned int i) {
+            const double dF_dd = advance(springs[first + i], increment[i], force[i], state + 3 * i);
+            if (tangent)
+              tangent[tangent_stride * i] = dF_dd;
+          });
         }
 
         double
@@ -497,15 +468,15 @@ namespace hysteron
         {
           case UniaxialVariant::pinching:
             return std::make_unique<FamilySprings<Pinching>>(
-              Pinching{p.alpha, p.n, p.beta, p.gamma, p.A0, p.delta_A, p.delta_nu, p.delta_eta,
+              Pinching{{p.alpha}, p.n, p.beta, p.gamma, p.A0, p.delta_A, p.delta_nu, p.delta_eta,
                        p.zeta_s, p.p, p.q, p.psi0, p.delta_psi, p.lambda},
               yield_stress, true);
           case UniaxialVariant::asymmetric:
             return std::make_unique<FamilySprings<Asymmetric>>(
-              Asymmetric{p.alpha, p.n, p.beta, p.gamma, p.compression_ratio}, yield_stress, true);
+              Asymmetric{{p.alpha}, p.n, p.beta, p.gamma, p.compression_ratio}, yield_stress, true);
           case UniaxialVariant::opensees_bouc_wen:
             return std::make_unique<FamilySprings<OpenSeesBoucWen>>(
-              OpenSeesBoucWen{p.alpha, p.n, p.beta, p.gamma, p.A0, p.delta_A, p.delta_nu, p.delta_eta},
+              OpenSeesBoucWen{{p.alpha}, p.n, p.beta, p.gamma, p.A0, p.delta_A, p.delta_nu, p.delta_eta},
               yield_stress, false);
           case UniaxialVariant::opensees_bouc_wen_original:
             return std::make_unique<FamilySprings<OpenSeesBoucWenOriginal>>(

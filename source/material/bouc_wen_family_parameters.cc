@@ -2,6 +2,9 @@
 #include <hysteron/base/exceptions.h>
 #include <hysteron/material/bouc_wen_family.h>
 
+#include <array>
+#include <vector>
+
 namespace hysteron
 {
   namespace Material
@@ -11,57 +14,60 @@ namespace hysteron
       using dealii::ParameterHandler;
       using dealii::Patterns::Double;
 
+      /// Entries of type Double in @p subsection: (name, default, documentation) each.
+      void
+      declare_doubles(ParameterHandler                                  &prm,
+                      const char                                        *subsection,
+                      const std::vector<std::array<const char *, 3>>    &entries)
+      {
+        prm.enter_subsection(subsection);
+        for (const auto &e : entries)
+          prm.declare_entry(e[0], e[1], Double(), e[2]);
+        prm.leave_subsection();
+      }
+
       void
       declare_pinching(ParameterHandler &prm)
       {
-        prm.enter_subsection("Pinching");
-        {
-          const auto d = [&](const char *name, const char *value, const std::string &text) {
-            prm.declare_entry(name, value, Double(), text);
-          };
-          d("alpha", "0", "Post-yield stiffness ratio in [0, 1).");
-          d("n", "2", "Exponent n > 0 of |w|^n.");
-          d("beta", "0.5", "Factor of sgn(w x') (Foliente's and OpenSees' beta).");
-          d("gamma", "0.5", "The constant term; beta + gamma > 0.");
-          d("A0", "1", "Initial A > 0 (the initial tangent is alpha k + (1 - alpha) k A0).");
-          d("delta_A", "0", "A = A0 - delta_A e, >= 0 (e the normalised dissipated energy).");
-          d("delta_nu", "0", "Strength deterioration nu = 1 + delta_nu e, >= 0.");
-          d("delta_eta", "0", "Stiffness degradation eta = 1 + delta_eta e, >= 0.");
-          d("zeta_s", "0", "Pinching: its measure in [0, 1) (0: no pinching).");
-          d("p", "1", "Pinching: the rate of its onset with e, >= 0.");
-          d("q", "0.1", "Pinching: the fraction of the ultimate w_u where it acts, in [0, 1).");
-          d("psi_0", "0.2", "Pinching: the initial spread, > 0.");
-          d("delta_psi", "0.005", "Pinching: the growth of the spread with e, >= 0.");
-          d("lambda", "0.5", "Pinching: the coupling of spread and severity, > 0.");
-        }
-        prm.leave_subsection();
+        declare_doubles(prm,
+                        "Pinching",
+                        {{{"alpha", "0", "Post-yield stiffness ratio in [0, 1)."}},
+                         {{"n", "2", "Exponent n > 0 of |w|^n."}},
+                         {{"beta", "0.5", "Factor of sgn(w x') (Foliente's and OpenSees' beta)."}},
+                         {{"gamma", "0.5", "The constant term; beta + gamma > 0."}},
+                         {{"A0", "1", "Initial A > 0 (the initial tangent is alpha k + (1 - alpha) k A0)."}},
+                         {{"delta_A", "0", "A = A0 - delta_A e, >= 0 (e the normalised dissipated energy)."}},
+                         {{"delta_nu", "0", "Strength deterioration nu = 1 + delta_nu e, >= 0."}},
+                         {{"delta_eta", "0", "Stiffness degradation eta = 1 + delta_eta e, >= 0."}},
+                         {{"zeta_s", "0", "Pinching: its measure in [0, 1) (0: no pinching)."}},
+                         {{"p", "1", "Pinching: the rate of its onset with e, >= 0."}},
+                         {{"q", "0.1", "Pinching: the fraction of the ultimate w_u where it acts, in [0, 1)."}},
+                         {{"psi_0", "0.2", "Pinching: the initial spread, > 0."}},
+                         {{"delta_psi", "0.005", "Pinching: the growth of the spread with e, >= 0."}},
+                         {{"lambda", "0.5", "Pinching: the coupling of spread and severity, > 0."}}});
       }
 
       void
       declare_opensees(ParameterHandler &prm)
       {
-        prm.enter_subsection("OpenSees BoucWen");
-        {
-          prm.declare_entry("alpha", "0", Double(), "alpha of `uniaxialMaterial BoucWen`, [0, 1).");
-          prm.declare_entry("n", "1", Double(), "n, > 0.");
-          prm.declare_entry("gamma", "0.5", Double(), "gamma (the constant term) [delta^-n].");
-          prm.declare_entry("beta", "0.5", Double(), "beta (factor of sgn(z delta')) [delta^-n]; beta + gamma > 0.");
-          prm.declare_entry("Ao", "1", Double(), "Ao, > 0.");
-          prm.declare_entry("deltaA", "0", Double(), "deltaA, >= 0.");
-          prm.declare_entry("deltaNu", "0", Double(), "deltaNu, >= 0.");
-          prm.declare_entry("deltaEta", "0", Double(), "deltaEta, >= 0.");
-        }
-        prm.leave_subsection();
-        prm.enter_subsection("OpenSees BoucWenOriginal");
-        {
-          prm.declare_entry("alphaL", "0", Double(), "alphaL of `uniaxialMaterial BoucWenOriginal`, [0, 1).");
-          prm.declare_entry("alphaNL", "0", Double(), "alphaNL, >= 0.");
-          prm.declare_entry("mu", "2", Double(), "mu, the exponent of the nonlinear elastic term, >= 1.");
-          prm.declare_entry("eta", "1", Double(), "eta, the exponent of |u| (n of the other laws), > 0.");
-          prm.declare_entry("beta", "0.5", Double(), "beta (factor of sgn(u delta')).");
-          prm.declare_entry("gamma", "0.5", Double(), "gamma (the constant term); beta + gamma > 0.");
-        }
-        prm.leave_subsection();
+        declare_doubles(prm,
+                        "OpenSees BoucWen",
+                        {{{"alpha", "0", "alpha of `uniaxialMaterial BoucWen`, [0, 1)."}},
+                         {{"n", "1", "n, > 0."}},
+                         {{"gamma", "0.5", "gamma (the constant term) [delta^-n]."}},
+                         {{"beta", "0.5", "beta (factor of sgn(z delta')) [delta^-n]; beta + gamma > 0."}},
+                         {{"Ao", "1", "Ao, > 0."}},
+                         {{"deltaA", "0", "deltaA, >= 0."}},
+                         {{"deltaNu", "0", "deltaNu, >= 0."}},
+                         {{"deltaEta", "0", "deltaEta, >= 0."}}});
+        declare_doubles(prm,
+                        "OpenSees BoucWenOriginal",
+                        {{{"alphaL", "0", "alphaL of `uniaxialMaterial BoucWenOriginal`, [0, 1)."}},
+                         {{"alphaNL", "0", "alphaNL, >= 0."}},
+                         {{"mu", "2", "mu, the exponent of the nonlinear elastic term, >= 1."}},
+                         {{"eta", "1", "eta, the exponent of |u| (n of the other laws), > 0."}},
+                         {{"beta", "0.5", "beta (factor of sgn(u delta'))."}},
+                         {{"gamma", "0.5", "gamma (the constant term); beta + gamma > 0."}}});
       }
 
       void

@@ -3,6 +3,8 @@
 #include <hysteron/material/bouc_wen.h>
 #include <hysteron/material/bouc_wen_uniaxial.h>
 
+#include "material/update_each_spring.h"
+
 #include <vector>
 
 namespace hysteron
@@ -55,19 +57,10 @@ namespace hysteron
                std::string       &failure) const override
         {
           constexpr unsigned int stride = BoucWenUniaxial::max_n_state_variables;
-          unsigned int           failed = n;
-          for (unsigned int i = 0; i < n; ++i)
-            try
-              {
-                springs[first + i].update(increment[i], force[i], state + stride * i,
-                                          tangent ? tangent + tangent_stride * i : nullptr);
-              }
-            catch (const RuntimeError &error)
-              {
-                failure = error.what();
-                failed  = i;
-              }
-          return failed;
+          return update_each_spring(n, failure, [&](const unsigned int i) {
+            springs[first + i].update(increment[i], force[i], state + stride * i,
+                                      tangent ? tangent + tangent_stride * i : nullptr);
+          });
         }
 
         double
