@@ -341,9 +341,8 @@ namespace hysteron
                std::string       &failure) const override
         {
           return update_each_spring(n, failure, [&](const unsigned int i) {
-            const double dF_dd = advance(springs[first + i], increment[i], force[i], state + 3 * i);
-            if (tangent)
-              tangent[tangent_stride * i] = dF_dd;
+            advance(springs[first + i], increment[i], force[i], state + 3 * i,
+                    tangent ? tangent + tangent_stride * i : nullptr);
           });
         }
 
@@ -375,20 +374,26 @@ namespace hysteron
           return z1 - Dual{z0, 0} - D * law.rate(z1, e1, D.v, s);
         }
 
-        /// One increment: state and force to the end, returns dF / dDelta.
+        /// dz_1 / dDelta of the update from (z0, e0) by @p D that ended at @p z; for Delta = 0
+        /// the loading and unloading derivatives differ: the loading one.
         double
-        advance(const Spring &s, const double D, double &force, double *state) const
+        increment_derivative(const Spring &s, const double z0, const double e0, const double D, const double z) const
+        {
+          if (D == 0)
+            return law.rate(Dual{z0, 0}, Dual{e0, 0}, 1.0, s).v;
+          const Dual r_z = residual(s, z0, e0, Dual{z, 1}, Dual{D, 0});
+          const Dual r_D = residual(s, z0, e0, Dual{z, 0}, Dual{D, 1});
+          return -r_D.d / r_z.d;
+        }
+
+        /// One increment: state and force to the end; with @p tangent, dF / dDelta into it.
+        void
+        advance(const Spring &s, const double D, double &force, double *state, double *tangent) const
         {
           const double z0 = state[0], e0 = state[1], d0 = state[2];
-          const double scale = law.scale(z0, s);
-          double       z     = z0;
+          double       z  = z0;
           if (D != 0)
-            z = solve(s, z0, e0, D, scale);
-          const Dual   r_z = residual(s, z0, e0, Dual{z, 1}, Dual{D, 0});
-          const Dual   r_D = residual(s, z0, e0, Dual{z, 0}, Dual{D, 1});
-          // For Delta = 0 the loading and unloading derivatives differ: take the loading one.
-          const double dz_dD = D != 0 ? -r_D.d / r_z.d :
-                                        law.rate(Dual{z0, 0}, Dual{e0, 0}, 1.0, s).v;
+            z = solve(s, z0, e0, D, law.scale(z0, s));
           state[0]           = z;
           state[1]           = e0 + law.energy_factor(s) * D * z;
           state[2]           = d0 + D;
@@ -396,7 +401,8 @@ namespace hysteron
           force              = F.first;
           if (!std::isfinite(force) || !std::isfinite(state[1]))
             throw RuntimeError(failure_message("a force or energy that is not finite", D, z0));
-          return F.second + law.force_by_z(z, s) * dz_dD;
+          if (tangent)
+            *tangent = F.second + law.force_by_z(z, s) * increment_derivative(s, z0, e0, D, z);
         }
 
         /// The root z_1: a bracket grown from z_0 against the sign of r(z_0), then Newton.

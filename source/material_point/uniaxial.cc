@@ -218,13 +218,7 @@ namespace hysteron
       for (unsigned int step = 1; step <= n_steps; ++step)
         {
           const double t    = end_time * step / n_steps;
-          const double next = strain->value(dealii::Point<1>(t));
-          if (!std::isfinite(next))
-            {
-              std::ostringstream m;
-              m << "Uniaxial: the strain is not finite at step " << step << " (t = " << t << " s)";
-              throw RuntimeError(m.str());
-            }
+          const double next = strain_at(step);
           const double deps = next - eps;
           try
             {
