@@ -42,6 +42,8 @@ namespace hysteron
       // Body force densities and tractions at t1 (and t0 for HHT).
       const double t0    = t1 - dt;
       const auto  &loads = scene.load_descriptions();
+      body1              = scene.body_acceleration(t1);
+      body0              = scene.body_acceleration(t0);
       for (unsigned int l = 0; l < solver.load_sets.size(); ++l)
         {
           load1[l] = loads[solver.load_sets[l].load].value_at(t1) * solver.load_sets[l].scale;
@@ -83,7 +85,7 @@ namespace hysteron
         finite_strain_forces(h, scratch, copy);
       else
         small_strain_forces(h, scratch, copy);
-      external_forces(cell, h, load1, copy.fx, scratch);
+      external_forces(cell, h, body1, load1, copy.fx, scratch);
       if (dynamic)
         hht_terms(cell, h, scratch, copy);
       else

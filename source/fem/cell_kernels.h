@@ -213,6 +213,9 @@ namespace hysteron
       const bool dynamic; ///< HHT-alpha (dt = 0: the forces of the state only)
       /// The load sets' values at t1 and (dynamic) at t0 = t1 - dt.
       std::vector<dealii::Tensor<1, dim>> load1, load0;
+      /// The body force per unit mass at t1 and t0: gravity, minus the ground's
+      /// acceleration (Scene::body_acceleration()).
+      dealii::Tensor<1, dim> body1, body0;
 
     private:
       // Kinematics and material update (cell_kernels.cc).
@@ -279,10 +282,12 @@ namespace hysteron
       finite_strain_forces(const CellHistory<dim> &h, CellScratch<dim> &scratch, CellCopy &copy) const;
 
       // Loads (cell_kernels_loads.cc).
-      /// f = sum_q N_i (rho g + volume loads) w_q + tractions on the loaded boundary faces.
+      /// f = sum_q N_i (rho b + volume loads) w_q + tractions on the loaded boundary faces,
+      /// with the body force per unit mass @p b.
       void
       external_forces(const CellIterator                        &cell,
                       const CellHistory<dim>                    &h,
+                      const dealii::Tensor<1, dim>              &b,
                       const std::vector<dealii::Tensor<1, dim>> &value,
                       dealii::Vector<double>                    &f,
                       CellScratch<dim>                          &scratch) const;

@@ -71,7 +71,7 @@ namespace hysteron
       auto       &d        = scratch.dynamics;
       const auto &du       = scratch.du;
       converged_state_terms(h, scratch);
-      external_forces(cell, h, load0, d.fx0, scratch);
+      external_forces(cell, h, body0, load0, d.fx0, scratch);
       for (unsigned int i = 0; i < n; ++i)
         {
           d.v0[i] = solver.v_ghost(copy.dofs[i]);

@@ -8,6 +8,7 @@ namespace hysteron
     void
     CellKernels<dim>::external_forces(const CellIterator                        &cell,
                                       const CellHistory<dim>                    &h,
+                                      const dealii::Tensor<1, dim>              &body,
                                       const std::vector<dealii::Tensor<1, dim>> &value,
                                       dealii::Vector<double>                    &f,
                                       CellScratch<dim>                          &scratch) const
@@ -18,13 +19,12 @@ namespace hysteron
       using LoadSet                    = typename Solver<dim>::LoadSet;
       const dealii::FEValues<dim> &fv  = scratch.fv;
       dealii::FEFaceValues<dim>   &ffv = scratch.ffv;
-      const dealii::Tensor<1, dim> &g  = scene.gravity();
       const unsigned int n_loads       = solver.load_sets.size();
       const std::size_t  first         = cell->active_cell_index() * n_loads;
       f                                = 0;
       for (unsigned int q = 0; q < n_q; ++q)
         {
-          dealii::Tensor<1, dim> b = h.material->density() * g;
+          dealii::Tensor<1, dim> b = h.material->density() * body;
           for (unsigned int l = 0; l < n_loads; ++l)
             if (solver.cell_in_load[first + l] && solver.load_sets[l].kind == LoadSet::Kind::volume &&
                 solver.in_region(l, h.point[q]))

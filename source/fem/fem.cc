@@ -363,6 +363,10 @@ namespace hysteron
                   "Boundary " + b.name + "/Type",
                   "an absorbing boundary is a dashpot on the velocities, which a quasi-static "
                   "analysis does not have: use FEM/Analysis = implicit dynamics or explicit dynamics");
+      require(analysis != Analysis::quasi_static || scene.ground_motion().empty(),
+              "Ground motion/File",
+              "a ground motion is a base excitation, which needs inertia: use FEM/Analysis = "
+              "implicit dynamics or explicit dynamics");
       if (analysis == Analysis::quasi_static)
         for (const auto &b : bodies)
           require(!b.initial_velocity || b.rigid,

@@ -153,6 +153,13 @@ namespace hysteron
         return true;
       }
 
+      /// Base excitation in dynamic analyses (quasi-static ones refuse a record).
+      bool
+      takes_ground_motion() const override
+      {
+        return true;
+      }
+
     protected:
       void
       parse_parameters(dealii::ParameterHandler &prm) override;

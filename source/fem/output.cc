@@ -149,6 +149,7 @@ namespace hysteron
       // Probes: the owner of the cell gives position, displacement and velocity at
       // the point; the owner of the nearest quadrature point its stress and state.
       std::vector<double> rows(probes.size() * n_values, 0.0);
+      std::vector<double> accelerations(scene.ground_motion().empty() ? 0 : probes.size() * dim, 0.0);
       for (unsigned int i = 0; i < probes.size(); ++i)
         {
           double *row = rows.data() + i * n_values;
@@ -173,7 +174,7 @@ namespace hysteron
               const Quadrature<dim> at(probes[i].reference);
               FEValues<dim>         fv(*mapping, *fe, at, update_values);
               fv.reinit(probes[i].dof_cell);
-              std::vector<Tensor<1, dim>> uu(1), vv(1);
+              std::vector<Tensor<1, dim>> uu(1), vv(1), aa(1);
               fv[displacement].get_function_values(u_ghost, uu);
               fv[displacement].get_function_values(v_ghost, vv);
               for (unsigned int d = 0; d < dim; ++d)
@@ -181,6 +182,12 @@ namespace hysteron
                   row[d]           = probes[i].point[d] + uu[0][d];
                   row[dim + d]     = uu[0][d];
                   row[2 * dim + d] = vv[0][d];
+                }
+              if (!accelerations.empty())
+                {
+                  fv[displacement].get_function_values(a_ghost, aa);
+                  for (unsigned int d = 0; d < dim; ++d)
+                    accelerations[i * dim + d] = aa[0][d];
                 }
             }
         }
@@ -224,6 +231,8 @@ namespace hysteron
         for (const auto i : owned_dofs)
           kinetic += 0.5 * lumped_mass(i) * v(i) * v(i);
 
+      if (!accelerations.empty())
+        tables.set_probe_accelerations(std::move(accelerations));
       tables.write(t, rows, averages, {{kinetic, strain_energy, internal_work, external_work, boundary_work}},
                    reactions(), comm, set_history_values());
     }

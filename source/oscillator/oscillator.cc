@@ -111,12 +111,7 @@ namespace hysteron
                        const std::string        &section,
                        const bool                needs_record)
     {
-      // The record first: one Section open at a time (their paths start at the top).
-      {
-        Section           g(prm, {"Ground motion"});
-        const std::string file = dealii::Utilities::trim(g.get("File"));
-        record.parse_parameters(g, file.empty() ? "" : scene.resolve_input_file(file));
-      }
+      record = scene.ground_motion();
       Section           s(prm, {section});
       const std::string text = dealii::Utilities::trim(s.get("Ground acceleration"));
       time_step              = s.get_non_negative("Time step");

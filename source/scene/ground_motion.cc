@@ -66,7 +66,9 @@ namespace hysteron
                       "g) or a two-column CSV of time [s] and acceleration. Empty: no ground "
                       "motion. Resolved like the other input files (as given, else next to the "
                       "parameter file). The acceleration is linear between samples and zero "
-                      "after the last. Taken by the oscillator and spectrum methods.");
+                      "after the last. Taken by the oscillator and spectrum methods, and by the "
+                      "dynamic analyses of the fem, mpm and rbsn methods as uniform base "
+                      "excitation (supports move with the ground, displacements relative to it).");
     prm.declare_entry("Format",
                       "auto",
                       Patterns::Selection("auto|peer|csv"),
@@ -129,6 +131,14 @@ namespace hysteron
       read_csv(in, file, where);
     for (double &a : values)
       a *= scale;
+    // The integrals at the samples (the segment formulas of velocity() at s = dt).
+    velocities.assign(values.size(), 0.0);
+    displacements.assign(values.size(), 0.0);
+    for (std::size_t k = 0; k + 1 < values.size(); ++k)
+      {
+        velocities[k + 1]    = velocities[k] + (values[k] + values[k + 1]) * dt / 2;
+        displacements[k + 1] = displacements[k] + velocities[k] * dt + (2 * values[k] + values[k + 1]) * dt * dt / 6;
+      }
   }
 
 
@@ -241,6 +251,51 @@ namespace hysteron
     t0 = times[0];
     // The mean step, so that t_k = t_0 + k dt reproduces the last time.
     dt = (times.back() - times[0]) / (times.size() - 1);
+  }
+
+
+
+  bool
+  GroundMotion::locate(const double t, std::size_t &k, double &s) const
+  {
+    if (values.empty() || t < t0)
+      return false;
+    k = std::min(static_cast<std::size_t>(std::floor((t - t0) / dt)), values.size() - 1);
+    s = t - (t0 + k * dt);
+    return true;
+  }
+
+
+
+  // On a segment the acceleration is a_k + (a_{k+1} - a_k) s/dt, so
+  //   v = V_k + a_k s + (a_{k+1} - a_k) s^2/(2 dt),
+  //   d = D_k + V_k s + a_k s^2/2 + (a_{k+1} - a_k) s^3/(6 dt);
+  // after the last sample the ground moves on at V_last (the acceleration is zero).
+  double
+  GroundMotion::velocity(const double t) const
+  {
+    std::size_t k;
+    double      s;
+    if (!locate(t, k, s))
+      return 0;
+    if (k + 1 == values.size())
+      return velocities[k];
+    return velocities[k] + values[k] * s + (values[k + 1] - values[k]) * s * s / (2 * dt);
+  }
+
+
+
+  double
+  GroundMotion::displacement(const double t) const
+  {
+    std::size_t k;
+    double      s;
+    if (!locate(t, k, s))
+      return 0;
+    if (k + 1 == values.size())
+      return displacements[k] + velocities[k] * s;
+    return displacements[k] + velocities[k] * s + values[k] * s * s / 2 +
+           (values[k + 1] - values[k]) * s * s * s / (6 * dt);
   }
 
 

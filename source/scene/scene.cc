@@ -328,6 +328,14 @@ namespace hysteron
       }
 
     gravity_vector = parse_vector<dim>(prm.get("Gravity"), "Gravity");
+    {
+      Section           g(prm, {"Ground motion"});
+      const std::string file = dealii::Utilities::trim(g.get("File"));
+      ground.parse_parameters(g, file.empty() ? "" : resolve_input_file(file));
+      require(dim == 3 || ground.empty() || ground.direction()[2] == 0,
+              g.where("Direction"),
+              "has a third component in a 2D scene (the ground moves in the x-y plane)");
+    }
     const AmplitudeMap amplitudes = Amplitude::parse_all(prm, scene_names.amplitudes, [this](const std::string &f) {
       return resolve_input_file(f);
     });
@@ -391,8 +399,7 @@ namespace hysteron
       Section ground(prm, {"Ground motion"});
       require(dealii::Utilities::trim(ground.get("File")).empty() || method->takes_ground_motion(),
               ground.where("File"),
-              "the " + method_name_ + " method does not take a ground motion (the oscillator and "
-              "spectrum methods do)");
+              "the " + method_name_ + " method does not take a ground motion");
     }
     if (method->takes_continuum_materials())
       for (const auto &b : bodies)

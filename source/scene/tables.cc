@@ -27,6 +27,8 @@ namespace hysteron
       n_values         = point.size();
       point_names      = point;
       reaction_names   = reaction_columns(scene);
+      ground           = scene.ground_motion().empty() ? nullptr : &scene.ground_motion();
+      n_boundaries     = scene.boundary_descriptions().size();
       history_names.clear();
       for (const unsigned int k : scene.output_control().history_sets)
         history_names.push_back(scene.set_descriptions()[k].name);
@@ -37,6 +39,9 @@ namespace hysteron
         {
           std::vector<std::string> c{"time"};
           c.insert(c.end(), point.begin(), point.end());
+          if (ground)
+            for (unsigned int d = 0; d < dim; ++d)
+              c.push_back(std::string("a_") + component_names[d]);
           probe_tables.push_back(
             std::make_unique<Output::TimeTable>(file("probe_" + std::to_string(i) + ".csv"), c, run_record));
         }
@@ -50,6 +55,13 @@ namespace hysteron
       energy_table   = std::make_unique<Output::TimeTable>(file("energy.csv"), energy_columns(damping_column), run_record);
       reaction_table =
         std::make_unique<Output::TimeTable>(file("reactions.csv"), reaction_columns(scene), run_record);
+      if (ground)
+        {
+          std::vector<std::string> c{"time", "a_g", "v_g", "d_g"};
+          for (unsigned int d = 0; d < dim; ++d)
+            c.push_back(std::string("base_") + component_names[d]);
+          ground_table = std::make_unique<Output::TimeTable>(file("ground.csv"), c, run_record);
+        }
       std::vector<std::string> c{"time"};
       for (const auto &name : history_columns())
         c.push_back(name);
@@ -159,6 +171,12 @@ namespace hysteron
         return;
       has_written = true;
       last_time   = t;
+      const std::size_t n_probes = probes.size() / std::max(1u, n_values);
+      if (!ground)
+        probe_accelerations.clear();
+      AssertThrow(!ground || probe_accelerations.size() == n_probes * dim,
+                  dealii::ExcMessage("a run with a ground motion needs the probes' accelerations "
+                                     "(set_probe_accelerations()) before each row"));
       // One reduction of everything, and none on one rank.
       if (dealii::Utilities::MPI::n_mpi_processes(comm) > 1)
         {
@@ -169,6 +187,7 @@ namespace hysteron
             for (unsigned int d = 0; d < dim; ++d)
               all.push_back(r[d]);
           all.insert(all.end(), histories.begin(), histories.end());
+          all.insert(all.end(), probe_accelerations.begin(), probe_accelerations.end());
           all.push_back(damping_work);
           dealii::Utilities::MPI::sum(all, comm, all);
           auto p = all.begin();
@@ -182,20 +201,31 @@ namespace hysteron
             for (unsigned int d = 0; d < dim; ++d)
               r[d] = *p++;
           std::copy(p, p + histories.size(), histories.begin());
-          damping_work = p[histories.size()];
+          p += histories.size();
+          std::copy(p, p + probe_accelerations.size(), probe_accelerations.begin());
+          damping_work = p[probe_accelerations.size()];
         }
       // The rows on every rank (the values are the same after the reduction), so that
       // a non-finite value stops every rank.
       std::vector<std::vector<double>> probe_rows, average_rows;
       std::vector<std::string>         names{"time"};
       names.insert(names.end(), point_names.begin(), point_names.end());
-      for (unsigned int i = 0; i < probes.size() / std::max(1u, n_values); ++i)
+      // The ground's motion along Direction, the absolute accelerations a + a_g d.
+      const double a_g = ground ? ground->acceleration(t) : 0.0;
+      if (ground)
+        names.insert(names.end(), {"a_x", "a_y", "a_z"});
+      for (unsigned int i = 0; i < n_probes; ++i)
         {
           std::vector<double> row{t};
           row.insert(row.end(), probes.begin() + i * n_values, probes.begin() + (i + 1) * n_values);
+          if (ground)
+            for (unsigned int d = 0; d < dim; ++d)
+              row.push_back(probe_accelerations[i * dim + d] + a_g * ground->direction()[d]);
           check_finite(t, row, "probe_" + std::to_string(i) + ".csv", names);
           probe_rows.push_back(std::move(row));
         }
+      if (ground)
+        names.resize(names.size() - 3);
       names.insert(names.begin() + 1, "mass");
       for (unsigned int i = 0; i < averages.size() / (1 + n_values); ++i)
         {
@@ -216,6 +246,19 @@ namespace hysteron
         for (unsigned int d = 0; d < dim; ++d)
           reaction_row.push_back(r[d]);
       check_finite(t, reaction_row, "reactions.csv", reaction_names);
+      std::vector<double> ground_row;
+      if (ground)
+        {
+          ground_row = {t, a_g, ground->velocity(t), ground->displacement(t)};
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              double base = 0;
+              for (unsigned int b = 0; b < n_boundaries; ++b)
+                base += reactions[b][d];
+              ground_row.push_back(base);
+            }
+          probe_accelerations.clear(); // each row needs its own
+        }
       std::vector<std::vector<double>> history_rows;
       std::vector<std::string>         history_header{"time"};
       for (const auto &name : history_columns())
@@ -238,6 +281,8 @@ namespace hysteron
         average_tables[i]->add_row(average_rows[i]);
       energy_table->add_row(energy_row);
       reaction_table->add_row(reaction_row);
+      if (ground_table)
+        ground_table->add_row(ground_row);
       history_ranges.resize(history_tables.size());
       for (unsigned int i = 0; i < history_tables.size(); ++i)
         {
@@ -288,7 +333,7 @@ namespace hysteron
         table->flush();
       for (auto &table : history_tables)
         table->flush();
-      for (auto *table : {energy_table.get(), reaction_table.get()})
+      for (auto *table : {energy_table.get(), reaction_table.get(), ground_table.get()})
         if (table)
           table->flush();
     }

@@ -87,7 +87,7 @@ def main():
            ("decreasing.csv", "oscillator", r"decreasing\.csv:3: the times must increase"),
            ("columns.csv", "oscillator", r"columns\.csv:2: expected two columns"),
            ("absent.AT2", "oscillator", r"absent\.AT2"),
-           ("new.AT2", "fem", r"the fem method does not take a ground motion")]
+           ("new.AT2", "uniaxial", r"the uniaxial method does not take a ground motion")]
     for file, method, pattern in bad:
         stem = "bad_" + file.replace(".", "_") + "_" + method
         code, stderr = run(hysteron, workdir, stem, SCENE.format(method=method, file=file, name=stem),

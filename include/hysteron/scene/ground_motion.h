@@ -55,6 +55,17 @@ namespace hysteron
     double
     acceleration(double t) const;
 
+    /// The ground's velocity along Direction at time @p t [m/s]: the exact integral of
+    /// the piecewise-linear acceleration from rest at t = 0.
+    double
+    velocity(double t) const;
+
+    /// The ground's displacement along Direction at time @p t [m]: the exact double
+    /// integral of the piecewise-linear acceleration (no baseline correction: a record's
+    /// drift shows here, never in the relative motion the field methods compute).
+    double
+    displacement(double t) const;
+
     /// The sampling step of the record [s].
     double
     time_step() const
@@ -89,7 +100,13 @@ namespace hysteron
     void
     read_csv(std::istream &in, const std::string &name, const std::string &where);
 
+    /// The segment of @p t: k with t_k <= t < t_{k+1}, and s = t - t_k (k = size() - 1 after
+    /// the last sample); false before the first sample.
+    bool
+    locate(double t, std::size_t &k, double &s) const;
+
     std::vector<double> values; ///< scaled samples
+    std::vector<double> velocities, displacements; ///< the integrals at the samples
     double              t0    = 0;
     double              dt    = 0;
     double              scale = 1;

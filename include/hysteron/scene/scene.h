@@ -9,6 +9,7 @@
 
 #include <hysteron/material/interface.h>
 #include <hysteron/scene/description.h>
+#include <hysteron/scene/ground_motion.h>
 #include <hysteron/scene/method.h>
 #include <hysteron/scene/output_column.h>
 
@@ -193,6 +194,40 @@ namespace hysteron
       return gravity_vector;
     }
 
+    /// `subsection Ground motion`: the record (empty() without `File`).
+    const GroundMotion &
+    ground_motion() const
+    {
+      return ground;
+    }
+
+    /// The ground's acceleration a_g(t) d at time @p t (zero without a record).
+    dealii::Tensor<1, dim>
+    ground_acceleration(const double t) const
+    {
+      dealii::Tensor<1, dim> a;
+      if (!ground.empty())
+        {
+          const double a_g = ground.acceleration(t);
+          for (unsigned int i = 0; i < dim; ++i)
+            a[i] = a_g * ground.direction()[i];
+        }
+      return a;
+    }
+
+    /**
+     * The body force per unit mass at time @p t [m/s^2]. The field methods solve for
+     * the motion relative to the ground: with u the relative displacement, the absolute
+     * acceleration is u'' + a_g(t) d, so the ground's motion enters as the body force
+     * -a_g(t) d beside gravity, g - a_g(t) d; supports hold u = 0 (they move with the
+     * ground) and their reactions are the base forces.
+     */
+    dealii::Tensor<1, dim>
+    body_acceleration(const double t) const
+    {
+      return gravity_vector - ground_acceleration(t);
+    }
+
     const TimeControl &
     time_control() const
     {
@@ -341,6 +376,7 @@ namespace hysteron
     std::vector<LoadDescription<dim>>                               loads;
     std::vector<SetDescription<dim>>                                sets;
     dealii::Tensor<1, dim>                                          gravity_vector;
+    GroundMotion                                                    ground;
     TimeControl                                                     time;
     OutputControl<dim>                                              output;
     CheckpointControl                                               checkpoint;

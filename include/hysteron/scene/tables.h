@@ -6,6 +6,7 @@
 
 #include <hysteron/base/output.h>
 #include <hysteron/base/checkpoint.h>
+#include <hysteron/scene/ground_motion.h>
 #include <hysteron/scene/point_data.h>
 
 #include <algorithm>
@@ -73,6 +74,21 @@ namespace hysteron
             std::vector<double>                  histories    = {},
             double                               damping_work = 0);
 
+      /**
+       * With a ground motion (Scene::ground_motion()), the relative accelerations at the
+       * probes for the next write(): n_probes x dim partial sums like the probes' values.
+       * The probe tables then end with a_x, a_y(, a_z), the absolute acceleration
+       * (these plus a_g(t) d), and ground.csv holds the ground's own motion along
+       * Direction (a_g, v_g, d_g) and the base force: the sum of the reactions of all
+       * `Boundary` conditions. A method that takes a ground motion calls this before
+       * every write().
+       */
+      void
+      set_probe_accelerations(std::vector<double> relative)
+      {
+        probe_accelerations = std::move(relative);
+      }
+
       /// The columns of history_<set>.csv after `time`: u_x, u_y(, u_z), reaction_x, ...,
       /// load_x, ...
       static std::vector<std::string>
@@ -100,7 +116,10 @@ namespace hysteron
     private:
       Output::RunRecord                              *record = nullptr; ///< of open()
       std::vector<std::unique_ptr<Output::TimeTable>> probe_tables, average_tables;
-      std::unique_ptr<Output::TimeTable>              energy_table, reaction_table;
+      std::unique_ptr<Output::TimeTable>              energy_table, reaction_table, ground_table;
+      const GroundMotion                             *ground = nullptr; ///< of open(), null without a record
+      unsigned int                                    n_boundaries = 0; ///< the scene's Boundary conditions
+      std::vector<double>                             probe_accelerations; ///< set_probe_accelerations()
       std::vector<std::unique_ptr<Output::TimeTable>> history_tables;
       std::vector<std::string>                        history_names, history_paths;
       /// Per history table and column (after time): the smallest and largest value written.
