@@ -282,12 +282,12 @@ namespace hysteron
       finite_strain_forces(const CellHistory<dim> &h, CellScratch<dim> &scratch, CellCopy &copy) const;
 
       // Loads (cell_kernels_loads.cc).
-      /// f = sum_q N_i (rho b + volume loads) w_q + tractions on the loaded boundary faces,
-      /// with the body force per unit mass @p b.
+      /// f = sum_q N_i (rho g + volume loads) w_q + tractions on the loaded boundary faces,
+      /// with the body force per unit mass @p g.
       void
       external_forces(const CellIterator                        &cell,
                       const CellHistory<dim>                    &h,
-                      const dealii::Tensor<1, dim>              &b,
+                      const dealii::Tensor<1, dim>              &g,
                       const std::vector<dealii::Tensor<1, dim>> &value,
                       dealii::Vector<double>                    &f,
                       CellScratch<dim>                          &scratch) const;

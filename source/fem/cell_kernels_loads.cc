@@ -8,7 +8,7 @@ namespace hysteron
     void
     CellKernels<dim>::external_forces(const CellIterator                        &cell,
                                       const CellHistory<dim>                    &h,
-                                      const dealii::Tensor<1, dim>              &body,
+                                      const dealii::Tensor<1, dim>              &g,
                                       const std::vector<dealii::Tensor<1, dim>> &value,
                                       dealii::Vector<double>                    &f,
                                       CellScratch<dim>                          &scratch) const
@@ -24,7 +24,7 @@ namespace hysteron
       f                                = 0;
       for (unsigned int q = 0; q < n_q; ++q)
         {
-          dealii::Tensor<1, dim> b = h.material->density() * body;
+          dealii::Tensor<1, dim> b = h.material->density() * g;
           for (unsigned int l = 0; l < n_loads; ++l)
             if (solver.cell_in_load[first + l] && solver.load_sets[l].kind == LoadSet::Kind::volume &&
                 solver.in_region(l, h.point[q]))
