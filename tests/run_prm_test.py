@@ -286,7 +286,8 @@ def main():
                 failures.append(f"{ranks} ranks: exit status {code2}: {err2[-2000:]}")
                 continue
             one, two = output_files(args.workdir), output_files(mpi_dir)
-            comparable = [f for f in one if f.endswith(".csv")]
+            inputs_here = {os.path.normpath(x) for x in inputs}  # the scene's inputs are no output
+            comparable = [f for f in one if f.endswith(".csv") and os.path.normpath(f) not in inputs_here]
             ignored = [x.strip() for k, _, v in directives if k == "MPI-IGNORE" for x in v.split(",")]
             for f in comparable:
                 if f not in two:

@@ -240,10 +240,18 @@ namespace hysteron
         {
           // The dashpots of absorbing boundaries do the work -1/2 (C_b v_n + C_b v_n+1) . du on
           // the body (trapezoidal like the other works, so that Newmark's balance stays exact).
-          Vector dashpot = absorbers.empty() ? Vector() : absorbing_force(v_ghost);
+          Vector dashpot  = absorbers.empty() ? Vector() : absorbing_force(v_ghost);
+          Vector rayleigh = has_rayleigh_damping() ? rayleigh_force(v_ghost) : Vector();
           dynamics.update(increment, dt, v, a);
           v_ghost = v;
           a_ghost = a;
+          // Likewise the Rayleigh forces do -1/2 (C v_n + C v_n+1) . du: dissipated.
+          if (has_rayleigh_damping())
+            {
+              rayleigh += rayleigh_force(v_ghost);
+              for (const auto i : owned_dofs)
+                damping_work += 0.5 * rayleigh(i) * increment(i);
+            }
           if (!absorbers.empty())
             {
               dashpot += absorbing_force(v_ghost);

@@ -54,7 +54,7 @@ namespace hysteron
       }
 
       /// The format of what this file stores: raise it with every change of a description below.
-      constexpr std::uint32_t format = 2;
+      constexpr std::uint32_t format = 3;
 
       /**
        * One cell's record, for save and load alike: the cell's values of the
@@ -115,7 +115,7 @@ namespace hysteron
     Solver<dim>::serialize_rank(Archive &ar)
     {
       ar.section("fem rank", format);
-      ar &internal_work &external_work &boundary_work &wall_forces;
+      ar &internal_work &external_work &boundary_work &wall_forces &damping_work;
     }
 
 
@@ -176,7 +176,7 @@ namespace hysteron
         {
           Run::sum_rank_parts(rank_parts, this->get_scene().is_root(),
                               [this](CheckpointReader &part) { serialize_rank(part); },
-                              internal_work, external_work, boundary_work, wall_forces);
+                              internal_work, external_work, boundary_work, wall_forces, damping_work);
         }
 
       // Each owned cell's values go into the owned entries (the cells that share a DoF

@@ -77,6 +77,54 @@ namespace hysteron
 
 
     template <int dim>
+    typename Solver<dim>::Vector
+    Solver<dim>::rayleigh_force(const Vector &velocity) const
+    {
+      // y = a0 M v + a1 K0 v with the consistent M = sum_q rho N_i N_j w_q (per component),
+      // as Newmark's residual has it (cell_kernels_dynamics.cc).
+      using namespace dealii;
+      Vector y(owned_dofs, this->get_scene().mpi_communicator());
+      if (dynamics.rayleigh_stiffness > 0)
+        {
+          elastic_stiffness_product(velocity, y);
+          y *= dynamics.rayleigh_stiffness;
+        }
+      const unsigned int n   = fe->n_dofs_per_cell();
+      const unsigned int n_q = quadrature->size();
+      FEValues<dim>      fv(*mapping, *fe, *quadrature, update_values);
+      std::vector<types::global_dof_index> dofs(n);
+      dealii::Vector<double>               ve(n), ye(n);
+      if (dynamics.rayleigh_mass > 0)
+        for (const auto &cell : dof_handler.active_cell_iterators())
+          if (cell->is_locally_owned())
+            {
+              fv.reinit(cell);
+              cell->get_dof_indices(dofs);
+              const CellHistory<dim> &h = *cell_history[cell->active_cell_index()];
+              for (unsigned int i = 0; i < n; ++i)
+                ve[i] = velocity(dofs[i]);
+              ye = 0;
+              for (unsigned int q = 0; q < n_q; ++q)
+                for (unsigned int c = 0; c < dim; ++c)
+                  {
+                    double vq = 0; // component c of v at the point
+                    for (unsigned int j = 0; j < n; ++j)
+                      if (fe->system_to_component_index(j).first == c)
+                        vq += fv.shape_value(j, q) * ve[j];
+                    for (unsigned int i = 0; i < n; ++i)
+                      if (fe->system_to_component_index(i).first == c)
+                        ye[i] += dynamics.rayleigh_mass * h.material->density() * fv.shape_value(i, q) * vq *
+                                 h.weight[q];
+                  }
+              y.add(dofs, ye);
+            }
+      y.compress(VectorOperation::add);
+      return y;
+    }
+
+
+
+    template <int dim>
     double
     Solver<dim>::critical_time_step()
     {
@@ -404,6 +452,13 @@ namespace hysteron
       Vector damping(owned_dofs, comm);
       damping_force(v_half, damping, 1.0);
       force -= damping;
+      // The Rayleigh forces (C v_1/2 less the dashpots', which are boundary work) act over
+      // the step: their work C v_1/2 . du is dissipated.
+      double step_damping = 0;
+      if (has_rayleigh_damping())
+        for (const auto i : owned_dofs)
+          step_damping += (damping(i) - (absorbers.empty() ? 0.0 : absorbing_lumped(i) * v_half(i))) *
+                          (u_trial(i) - u(i));
       Vector a_new(owned_dofs, comm);
       for (const auto i : owned_dofs)
         a_new(i) = force(i) / lumped_mass(i);
@@ -472,6 +527,7 @@ namespace hysteron
       inertia.compress(VectorOperation::insert);
       wall_forces = contact;      // this rank's part, like every table value
       boundary_work += step_work;
+      damping_work += step_damping;
       commit(t1, dt);
       v_ghost = v;
       a_ghost = a;

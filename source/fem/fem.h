@@ -618,6 +618,20 @@ namespace hysteron
       std::unique_ptr<Output::TimeTable>               newton_table;
       /// Work of this rank's cells and DoFs since t = 0 (summed when a row is written).
       double internal_work = 0, external_work = 0, boundary_work = 0;
+      /// Whether a dynamic analysis has Rayleigh damping (a0 or a1 > 0).
+      bool
+      has_rayleigh_damping() const
+      {
+        return analysis != Analysis::quasi_static &&
+               (dynamics.rayleigh_mass > 0 || dynamics.rayleigh_stiffness > 0);
+      }
+      /// y = C v = a0 M v + a1 K0 v with the consistent mass (implicit dynamics), matrix-free,
+      /// for the damping work; @p velocity with ghosts.
+      Vector
+      rayleigh_force(const Vector &velocity) const;
+      /// Work of the Rayleigh damping forces C v (dissipated; the damping_work column of
+      /// energy.csv in dynamic analyses with Rayleigh damping).
+      double damping_work = 0;
       unsigned long n_newton = 0, n_cuts = 0, n_linear = 0;
       /// Wall time of the material updates inside assemble() (the timer table has the
       /// sections "FEM assembly", which includes them, and "FEM linear solve").

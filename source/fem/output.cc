@@ -90,7 +90,8 @@ namespace hysteron
       tables.open(scene,
                   this->output_directory(),
                   PointData::columns<dim>(state_names, scene.output_control().additional_columns),
-                  this->run_record());
+                  this->run_record(),
+                  has_rayleigh_damping());
       if (scene.is_root() && analysis != Analysis::explicit_dynamics)
         newton_table = std::make_unique<Output::TimeTable>(this->output_file("newton.csv"),
                                                            newton_columns(),
@@ -234,7 +235,7 @@ namespace hysteron
       if (!accelerations.empty())
         tables.set_probe_accelerations(std::move(accelerations));
       tables.write(t, rows, averages, {{kinetic, strain_energy, internal_work, external_work, boundary_work}},
-                   reactions(), comm, set_history_values());
+                   reactions(), comm, set_history_values(), damping_work);
     }
 
 

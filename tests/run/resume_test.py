@@ -43,14 +43,16 @@ def run(command, cwd, env, timeout=900):
     return p.returncode, p.stdout, p.stderr
 
 
-def tables(directory):
+def tables(directory, inputs=()):
+    """The CSV files a run wrote (not its checkpoints, not the scene's input files)."""
     found = {}
     for root, dirs, files in os.walk(directory):
         dirs[:] = [d for d in dirs if not d.startswith("checkpoint-")]
         for name in files:
-            if name.endswith(".csv"):
-                path = os.path.join(root, name)
-                found[os.path.relpath(path, directory)] = path
+            path = os.path.join(root, name)
+            relative = os.path.relpath(path, directory)
+            if name.endswith(".csv") and os.path.normpath(relative) not in inputs:
+                found[relative] = path
     return found
 
 
@@ -126,6 +128,7 @@ def main():
     ap.add_argument("prm")
     ap.add_argument("inputs", nargs="*")
     args = ap.parse_args()
+    inputs = {os.path.normpath(x) for x in args.inputs}
 
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OMPI_MCA_rmaps_base_oversubscribe="1")
@@ -144,8 +147,9 @@ def main():
         text += f"\nsubsection Checkpoint\n  set Interval = {interval}\nend\n"
         with open(os.path.join(directory, name), "w") as f:
             f.write(text)
-        for item in args.inputs:
-            target = os.path.join(directory, os.path.basename(item))
+        for item in args.inputs:  # paths relative to the scene, kept (records/x.csv)
+            target = os.path.join(directory, item)
+            os.makedirs(os.path.dirname(target), exist_ok=True)
             shutil.copy(os.path.join(os.path.dirname(os.path.abspath(args.prm)), item), target)
 
     # How many steps the run takes (its summary line), then the reference run.
@@ -188,7 +192,7 @@ def main():
             failures.append(f"{args.signal}: exit status {code}, expected 4")
         if not re.search(rf"{args.signal} received: .* stopped after step {at} .*hysteron --resume", err):
             failures.append(f"{args.signal}: no message naming the step and --resume")
-    for relative, path in tables(stopped).items():
+    for relative, path in tables(stopped, inputs).items():
         try:
             read_table(path)
         except ValueError as e:
@@ -199,7 +203,7 @@ def main():
         print(err[-3000:])
         failures.append(f"the resumed run exited with {code}")
     else:
-        expected, got = tables(reference), tables(stopped)
+        expected, got = tables(reference, inputs), tables(stopped, inputs)
         if sorted(expected) != sorted(got):
             failures.append(f"tables differ: {sorted(expected)} vs {sorted(got)}")
         for relative in sorted(expected):
