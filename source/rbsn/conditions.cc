@@ -307,8 +307,10 @@ namespace hysteron
     void
     Model<dim>::external_forces(const double t, Vector &f) const
     {
-      // Loads, and gravity at the centroids (a force and its moment about the nucleus),
-      // on the owned cells.
+      // Loads, and the body force at the centroids (a force and its moment about the
+      // nucleus), on the owned cells. The body force per unit mass is gravity minus the
+      // ground's acceleration a_g(t) d (Scene::body_acceleration()): with a ground motion
+      // the network moves relative to the ground, so its supports move with it.
       f                 = 0;
       const auto &loads = scene().load_descriptions();
       const auto  add   = [&](const unsigned int c, const dealii::Tensor<1, dim> &arm, const dealii::Tensor<1, dim> &F) {
@@ -329,7 +331,7 @@ namespace hysteron
           for (unsigned int k = 0; k < set.cells.size(); ++k)
             add(set.cells[k], set.arm[k], set.weight[k] * value);
         }
-      const dealii::Tensor<1, dim> &g = scene().gravity();
+      const dealii::Tensor<1, dim> g = scene().body_acceleration(t);
       if (g.norm() > 0)
         for (unsigned int c = 0; c < n_owned_cells; ++c)
           add(c, cell_offset[c], cell_mass[c] * g);

@@ -99,6 +99,14 @@ namespace hysteron
       std::string
       summary() const override;
 
+      /// Base excitation (`Ground motion`) in the dynamic analyses, Newmark / HHT and
+      /// variable order; the static and quasi-static ones refuse a record (parameters.cc).
+      bool
+      takes_ground_motion() const override
+      {
+        return true;
+      }
+
       /// The values of the system matrix (this rank's rows), in the pattern's order.
       std::vector<double>
       matrix_values() const;
@@ -480,6 +488,11 @@ namespace hysteron
       /// into @p out (the cell's columns, then the facet's; zeros where none).
       void
       point_values(const int c, const int e, const dealii::Point<dim> &x, double *out) const;
+      /// With a ground motion, the probes' relative accelerations a_c + alpha x (p - x_c)
+      /// of their cells (n_probes x dim, zeros for the probes of other ranks' cells), the
+      /// linearized rigid motion the probe's u and v columns are; empty without a record.
+      std::vector<double>
+      probe_accelerations() const;
       /// The number of cell columns of point_columns().
       static constexpr unsigned int n_cell_columns = 3 * dim + 2 * (n_dofs - dim);
       /// The number of columns of point_columns() without the additional ones.

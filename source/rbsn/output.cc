@@ -108,6 +108,31 @@ namespace hysteron
 
 
     template <int dim>
+    std::vector<double>
+    Model<dim>::probe_accelerations() const
+    {
+      // Differentiated twice in time, u(p) = u_c + theta x r gives a(p) = a_c + alpha x r
+      // with the cell's translational and angular accelerations: Newmark's (HHT's)
+      // acceleration vector, or the variable-order integrator's derivative of the
+      // velocities (to_model()). Relative to the ground, as u and v.
+      const auto         &probes = scene().output_control().probe_points;
+      std::vector<double> out(scene().ground_motion().empty() ? 0 : probes.size() * dim, 0.0);
+      for (unsigned int i = 0; i < probes.size() && !out.empty(); ++i)
+        if (const int c = probe_cell[i]; c >= 0)
+          {
+            std::array<double, n_dofs> A;
+            for (unsigned int k = 0; k < n_dofs; ++k)
+              A[k] = a.local_element(n_dofs * c + k);
+            const dealii::Tensor<1, dim> w = rigid_motion<dim>(A, probes[i] - local_nuclei[c]);
+            for (unsigned int d = 0; d < dim; ++d)
+              out[i * dim + d] = w[d];
+          }
+      return out;
+    }
+
+
+
+    template <int dim>
     void
     Model<dim>::locate_probes()
     {
@@ -327,6 +352,8 @@ namespace hysteron
               }
           histories.insert(histories.end(), row.begin(), row.end());
         }
+      if (!scene().ground_motion().empty())
+        tables.set_probe_accelerations(probe_accelerations());
       tables.write(t, rows, averages,
                    {{kinetic, strain_energy, share * internal_work, share * external_work, share * boundary_work}},
                    reactions, comm, histories);

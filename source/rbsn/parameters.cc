@@ -268,6 +268,10 @@ namespace hysteron
                    type == "quasi-static"      ? Analysis::quasi_static :
                    type == "implicit dynamics" ? Analysis::implicit_dynamics :
                                                  Analysis::variable_order;
+        require(dynamic() || scene().ground_motion().empty(),
+                "Ground motion/File",
+                "a ground motion is a base excitation, which needs inertia: use RBSN/Analysis = "
+                "implicit dynamics or variable order");
         time_step    = s.get_non_negative("Time step");
         n_increments = s.get_integer("Number of increments");
         spring_table = s.get_bool("Write spring table");
