@@ -22,7 +22,7 @@ namespace hysteron
     namespace
     {
       /// The format of what this file stores: raise it with every change of a description below.
-      constexpr std::uint32_t format = 2;
+      constexpr std::uint32_t format = 3;
 
       /// A facet's springs: the converged and trial state and the tangent.
       template <int dim, class Archive, class SpringsType>
@@ -45,7 +45,7 @@ namespace hysteron
       // factorizes its first matrix anew), not state.
       auto increment_state = increments.state();
       ar &force_scale &last_force_level &predictor_level &internal_work &external_work &boundary_work &n_ida_steps
-        &n_newton &n_broken &n_cuts &increment_state &fracture_energy;
+        &n_newton &n_broken &n_cuts &increment_state &fracture_energy &damping_work;
       if constexpr (Archive::is_loading)
         increments.restore(increment_state);
       tables.serialize(ar);

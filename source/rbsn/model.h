@@ -349,6 +349,20 @@ namespace hysteron
       /// Accept the trial state of a step of @p dt (in which facets @p broke).
       void
       commit(const double dt, const bool broke);
+      /// Whether the dynamics have Rayleigh damping (energy.csv then has damping_work).
+      bool
+      damped() const
+      {
+        return dynamic() && (dynamics.rayleigh_mass > 0 || dynamics.rayleigh_stiffness > 0);
+      }
+      /// The facets' deformation increments B (u_trial - u) of a step, before commit()
+      /// takes them (a damped analysis; broken facets 0).
+      std::vector<double>
+      deformation_increments() const;
+      /// This rank's work of the damping forces over a step, the trapezoidal rule
+      /// 1/2 du^T C (v0 + v1) with the step's deformation increments @p d_delta.
+      double
+      step_damping_work(const Vector &v0, const std::vector<double> &d_delta) const;
       /// x = K^-1 rhs (the owned entries; the caller distributes the constraints).
       void
       solve_linear(Vector &x);
@@ -656,6 +670,8 @@ namespace hysteron
       IncrementControl increments{1.0, 0};
       double internal_work = 0, external_work = 0, boundary_work = 0;
       double fracture_energy = 0; ///< released by breaks in static steps (in internal_work)
+      /// The work of the Rayleigh damping forces C v (dynamics with a0 or a1 > 0).
+      double damping_work = 0;
       unsigned long n_ida_steps = 0; ///< variable order: IDA's steps
       unsigned long n_newton = 0, n_broken = 0;
       unsigned int  n_cuts = 0;

@@ -197,7 +197,7 @@ namespace hysteron
     void
     Model<dim>::open_tables()
     {
-      tables.open(scene(), this->output_directory(), point_columns(), this->run_record());
+      tables.open(scene(), this->output_directory(), point_columns(), this->run_record(), damped());
       if (!scene().is_root())
         return;
       if (analysis == Analysis::variable_order)
@@ -356,7 +356,7 @@ namespace hysteron
         tables.set_probe_accelerations(probe_accelerations());
       tables.write(t, rows, averages,
                    {{kinetic, strain_energy, share * internal_work, share * external_work, share * boundary_work}},
-                   reactions, comm, histories);
+                   reactions, comm, histories, share * damping_work);
     }
 
 

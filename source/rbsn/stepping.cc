@@ -352,7 +352,18 @@ namespace hysteron
     Model<dim>::commit(const double dt, const bool broke)
     {
       const MPI_Comm comm = network_communicator();
-      double         work = 0; // of the intact springs in the step (trapezoidal rule)
+      // A damped step's work of C v needs its deformation increments and v0.
+      const bool          damped_step = damped() && analysis == Analysis::implicit_dynamics && dt > 0;
+      std::vector<double> d_delta;
+      Vector              v0;
+      if (damped_step)
+        {
+          d_delta = deformation_increments();
+          v0.reinit(partitioner);
+          v0 = v;
+          v0.update_ghost_values();
+        }
+      double work = 0; // of the intact springs in the step (trapezoidal rule)
       for (unsigned int e = 0; e < springs.size(); ++e)
         {
           Springs<dim> &sp = springs[e];
@@ -379,6 +390,8 @@ namespace hysteron
         }
       v.update_ghost_values();
       a.update_ghost_values();
+      if (damped_step)
+        damping_work += dealii::Utilities::MPI::sum(step_damping_work(v0, d_delta), comm);
       double       external = 0, boundary = 0;
       const unsigned int n_owned = u.locally_owned_size();
       for (unsigned int i = 0; i < n_owned; ++i)
@@ -409,6 +422,56 @@ namespace hysteron
       f_ext_old    = f_ext;
       force_scale  = std::max(force_scale, last_force_level);
       u            = u_trial;
+    }
+
+
+
+    template <int dim>
+    std::vector<double>
+    Model<dim>::deformation_increments() const
+    {
+      std::vector<double> d(n_dofs * springs.size(), 0.0);
+      for (unsigned int e = 0; e < springs.size(); ++e)
+        if (!springs[e].broken)
+          for (unsigned int i = 0; i < n_dofs; ++i)
+            d[n_dofs * e + i] = springs[e].trial_delta[i] - springs[e].delta[i];
+      return d;
+    }
+
+
+
+    template <int dim>
+    double
+    Model<dim>::step_damping_work(const Vector &v0, const std::vector<double> &d_delta) const
+    {
+      // 1/2 du^T C (v0 + v1) with C = a0 M + a1 K0: the cells' a0 du_c^T M_c (v0 + v1)_c and
+      // the intact facets' a1 k_i (B_i du) (B_i (v0 + v1)) (B du = the springs' increments).
+      // With Newmark's average acceleration the energy balance then closes exactly.
+      const double               a0 = dynamics.rayleigh_mass, a1 = dynamics.rayleigh_stiffness;
+      double                     work = 0;
+      dealii::FullMatrix<double> M(n_dofs, n_dofs);
+      for (unsigned int c = 0; c < n_owned_cells && a0 > 0; ++c)
+        {
+          cell_mass_matrix(c, M);
+          for (unsigned int p = 0; p < n_dofs; ++p)
+            for (unsigned int q = 0; q < n_dofs; ++q)
+              {
+                const unsigned int ip = n_dofs * c + p, iq = n_dofs * c + q;
+                work += 0.5 * a0 * (u_trial.local_element(ip) - u.local_element(ip)) * M(p, q) *
+                        (v0.local_element(iq) + v.local_element(iq));
+              }
+        }
+      std::array<double, 2 * n_dofs> W;
+      for (unsigned int e = 0; e < springs.size() && a1 > 0; ++e)
+        if (!springs[e].broken)
+          {
+            const auto ld = facet_local_dofs(e);
+            for (unsigned int k = 0; k < 2 * n_dofs; ++k)
+              W[k] = v0.local_element(ld[k]) + v.local_element(ld[k]);
+            for (unsigned int i = 0; i < n_dofs; ++i)
+              work += 0.5 * a1 * springs[e].k[i] * d_delta[n_dofs * e + i] * springs[e].deformation(i, W);
+          }
+      return work;
     }
 
 

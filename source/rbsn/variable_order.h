@@ -15,13 +15,14 @@
  * implicit DAE F(t, y, y') = 0 in y = (u, v, s, W), integrated by SUNDIALS IDA
  * (variable-order, variable-step BDF with local error control; base/ida_integrator.h).
  * With n = 3 (2D) or 6 (3D) DoFs per cell, s the Bouc-Wen states of the hysteretic
- * springs (z, and eta, e_h with degradation), and W three work quadratures:
+ * springs (z, and eta, e_h with degradation), and W four work quadratures:
  *
  *   free DoF i:        u_i' - v_i = 0,
  *                      (M v' + C v + f_int(u, s) - f_ext(t))_i = 0,
  *   prescribed DoF i:  u_i' - w_i(t) = 0,   v_i - w_i(t) = 0   (algebraic),
  *   spring states:     s' - R(s, delta') = 0,   delta' = B v   (the Bouc-Wen rates),
  *   works:             W_int' = f_int . v,  W_ext' = f_ext . v,  W_bnd' = r . w,
+ *                      W_damp' = v . C v,
  *
  * with M the cell mass matrices (eq. 3.12), C = a0 M + a1 K0 (K0: the elastic
  * springs, as in the Newmark analysis), f_int = sum_e B^T F, F_i = a k delta_i +

@@ -44,7 +44,7 @@ namespace hysteron
               state_offset[n_dofs * e + i] = n_states;
               n_states += law(e, i).n_state_variables();
             }
-      n_total = 2 * n + n_states + 3;
+      n_total = 2 * n + n_states + 4;
       w.assign(n, 0.0);
       reaction.reinit(n);
       lu_rhs.reinit(n_total);
@@ -189,7 +189,15 @@ namespace hysteron
             for (unsigned int q = 0; q < n_dofs; ++q)
               reaction(n_dofs * c + p) += M(p, q) * (yp[n + n_dofs * c + q] + a0 * y[n + n_dofs * c + q]);
         }
-      double power_int = 0, power_ext = 0, power_bnd = 0;
+      // The damping's power v . C v: a0 v^T M v of the cells, a1 k delta'^2 of the springs.
+      double power_int = 0, power_ext = 0, power_bnd = 0, power_damp = 0;
+      for (unsigned int c = 0; c < m.n_owned_cells && a0 > 0; ++c)
+        {
+          m.cell_mass_matrix(c, M);
+          for (unsigned int p = 0; p < n_dofs; ++p)
+            for (unsigned int q = 0; q < n_dofs; ++q)
+              power_damp += a0 * y[n + n_dofs * c + p] * M(p, q) * y[n + n_dofs * c + q];
+        }
       std::array<double, 2 * n_dofs> U, V;
       for (unsigned int e = 0; e < m.springs.size(); ++e)
         {
@@ -218,6 +226,7 @@ namespace hysteron
                     F[s0 + j] = yp[s0 + j] - R[j];
                 }
               power_int += force * rate;
+              power_damp += a1 * sp.k[i] * rate * rate;
               const double total = force + a1 * sp.k[i] * rate;
               for (unsigned int k = 0; k < 2 * n_dofs; ++k)
                 reaction(dofs[k]) += sp.B[i][k] * total;
@@ -235,6 +244,7 @@ namespace hysteron
       F[iw]     = yp[iw] - power_int;
       F[iw + 1] = yp[iw + 1] - power_ext;
       F[iw + 2] = yp[iw + 2] - power_bnd;
+      F[iw + 3] = yp[iw + 3] - power_damp;
       return all_finite(F) ? 0 : 1;
     }
 
@@ -367,6 +377,7 @@ namespace hysteron
       y(iw)     = m.internal_work;
       y(iw + 1) = m.external_work;
       y(iw + 2) = m.boundary_work;
+      y(iw + 3) = m.damping_work;
       Vector F(n_total);
       residual(0, dealii::make_array_view(y), dealii::make_array_view(yp), dealii::make_array_view(F));
       for (unsigned int j = 0; j < n_total; ++j)
@@ -422,6 +433,7 @@ namespace hysteron
       m.internal_work       = y(iw);
       m.external_work       = y(iw + 1);
       m.boundary_work       = y(iw + 2);
+      m.damping_work        = y(iw + 3);
     }
 
     template class Model<2>;
