@@ -127,6 +127,13 @@ namespace hysteron
         return true;
       }
 
+      /// Base excitation (doc/mpm.md "Base excitation"): the body force -a_g(t) d.
+      bool
+      takes_ground_motion() const override
+      {
+        return true;
+      }
+
     protected:
       void
       parse_parameters(dealii::ParameterHandler &prm) override;
@@ -453,6 +460,14 @@ namespace hysteron
       std::vector<bool> boundary_acted; ///< per boundary: has it constrained a node with mass
       std::vector<Probe>                                 probes;
       std::vector<dealii::Tensor<1, dim>>                load_per_point; ///< per load, at t
+      /// The body force per unit mass at the step's start t, g - a_g(t) d (begin_step()).
+      dealii::Tensor<1, dim>                             body_acceleration;
+      /// With a ground motion: per probe, the relative acceleration (v_p' - v_p) / dt of
+      /// its point in the last step on the rank that took the step for it, zero on the
+      /// others (partial sums, as the tables take them); empty without a ground motion.
+      std::vector<dealii::Tensor<1, dim>>                probe_acceleration;
+      void
+      record_probe_accelerations(const double dt);
       std::vector<double>                                load_scale;     ///< 1 / count or area
       std::vector<std::vector<double>>                   particle_load_area;
 
