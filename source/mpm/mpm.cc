@@ -456,6 +456,7 @@ namespace hysteron
         }
       setup_boundaries();
       setup_grid_motion();
+      setup_absorbing();
       // The smallest mass a node may have and still get a velocity.
       double m_min = std::numeric_limits<double>::max();
       for (const double m : particles.mass)
@@ -463,7 +464,7 @@ namespace hysteron
       m_min      = dealii::Utilities::MPI::min(m_min, scene.mpi_communicator());
       small_mass = 1e-12 * m_min;
       // The basis and contact are chosen once: the phase kernels are templates of them.
-      if (nodal_damping.active() && !contact)
+      if ((nodal_damping.active() || !dashpots.empty()) && !contact)
         mark_boundary_nodes();
       if (contact)
         {

@@ -46,14 +46,16 @@ namespace hysteron
 
       /**
        * The velocity change over @p dt of one component of a node with 1 / m = @p inv_m,
-       * velocity @p v and force @p f, from m (v' - v) / dt = f - alpha |f| sgn(v) - a0 m
-       * (v + v') / 2 (the mass term trapezoidal: exact decay to O((a0 dt)^3), any a0 dt stable).
+       * velocity @p v and force @p f, from m (v' - v) / dt = f - alpha |f| sgn(v) - (a0 m + c)
+       * (v + v') / 2 (the viscous terms trapezoidal: exact decay to O((a0 dt)^3), any a0 dt
+       * stable), with the dashpot c of absorbing boundaries given as @p extra = c / m.
        */
       double
-      velocity_change(const double inv_m, const double v, const double f, const double dt) const
+      velocity_change(const double inv_m, const double v, const double f, const double dt, const double extra = 0) const
       {
         const double f_local = f - local * std::abs(f) * ((v > 0) - (v < 0));
-        return dt * (f_local * inv_m - mass * v) / (1.0 + 0.5 * mass * dt);
+        const double rate    = mass + extra;
+        return dt * (f_local * inv_m - rate * v) / (1.0 + 0.5 * rate * dt);
       }
 
       /// The work the damping forces of velocity_change() take out over @p dt (mass @p m,
@@ -353,9 +355,34 @@ namespace hysteron
       nodal_velocities();
       void
       update_nodal_velocities(const double dt);
-      /// update_nodal_velocities() with the nodal damping, and its work (damping.cc).
+      /// update_nodal_velocities() with the nodal damping and the dashpots of absorbing
+      /// boundaries, and their work (damping.cc).
       void
       update_damped_nodal_velocities(const double dt);
+
+      // Absorbing boundaries (`Boundary/Type = absorbing`, absorbing.cc; doc/mpm.md
+      // "Absorbing boundaries"): Lysmer-Kuhlemeyer dashpots on the grid nodes of faces.
+      struct Dashpot
+      {
+        unsigned int           node     = 0; ///< local grid node
+        unsigned int           boundary = 0; ///< index of the condition (its reaction)
+        dealii::Tensor<1, dim> c;            ///< per component: rho c_p A (normal), rho c_s A [kg/s]
+      };
+      /// Sorted by node; a node on several absorbing faces has one per face.
+      std::vector<Dashpot>    dashpots;
+      /// Per local node: 1 + the index of its first dashpot, 0: none.
+      ZeroPages<unsigned int> dashpot_first;
+      /// After setup_boundaries(): the dashpots of every absorbing condition.
+      void
+      setup_absorbing();
+      /// The deformable body whose material lies behind the absorbing condition @p b
+      /// (points in the grid cells next to its faces); refused if none or several materials.
+      unsigned int
+      absorbing_body(const unsigned int b) const;
+      /// The forces of the dashpots from @p first (of node n) on component @p d at the
+      /// mid-step velocity @p v_mid: their reactions and work (boundary_work).
+      void
+      record_dashpots(const unsigned int first, const unsigned int d, const double v_mid, const double dt);
 
       // Damping (`MPM/Damping`, damping.cc; doc/mpm.md, "Damping").
       NodalDamping nodal_damping;

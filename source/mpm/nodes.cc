@@ -75,7 +75,7 @@ namespace hysteron
       constexpr unsigned int C    = 1 + 2 * dim;
       double *const          node = grid->data().data();
       const double           tiny = small_mass;
-      if (nodal_damping.active())
+      if (nodal_damping.active() || !dashpots.empty())
         update_damped_nodal_velocities(dt);
       else if (nodes_hold_momenta)
         // Delta v_i = dt f_i / m_i, v_i' = p_i / m_i + Delta v_i; nodes without
