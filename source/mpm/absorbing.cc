@@ -50,7 +50,9 @@ namespace hysteron
               for (unsigned int e = 0; e < dim; ++e)
                 last[e] = n_cells[e] - 1;
               first[face / 2] = last[face / 2] = face % 2 == 0 ? 0 : n_cells[face / 2] - 1;
-              touches = touches || !Geometry::fill<dim>(bodies[k].shape, lattice, bodies[k].particles_per_cell, first, last).empty();
+              touches = touches ||
+                        !Geometry::fill<dim>(bodies[k].shape, lattice, bodies[k].particles_per_cell, first, last)
+                           .empty();
             }
           if (!touches)
             continue;
@@ -106,7 +108,10 @@ namespace hysteron
               double             area = body.thickness_at(grid->node_position(bc.nodes[k]));
               for (unsigned int e = 0; e < dim; ++e)
                 if (e != d)
-                  area *= lattice.h[e] * (i[e] == 0 || i[e] == static_cast<int>(lattice.n_cells[e]) ? 0.5 : 1.0);
+                  {
+                    const bool edge = i[e] == 0 || i[e] == static_cast<int>(lattice.n_cells[e]);
+                    area *= lattice.h[e] * (edge ? 0.5 : 1.0);
+                  }
               Dashpot dashpot;
               dashpot.node     = bc.nodes[k];
               dashpot.boundary = b;
@@ -115,7 +120,9 @@ namespace hysteron
               dashpots.push_back(dashpot);
             }
         }
-      std::stable_sort(dashpots.begin(), dashpots.end(), [](const Dashpot &a, const Dashpot &b) { return a.node < b.node; });
+      std::stable_sort(dashpots.begin(), dashpots.end(), [](const Dashpot &a, const Dashpot &b) {
+        return a.node < b.node;
+      });
       dashpot_first.reset(grid->n_local_nodes(), grid->sparse_box());
       for (std::size_t k = dashpots.size(); k-- > 0;)
         dashpot_first[dashpots[k].node] = k + 1;
@@ -125,7 +132,10 @@ namespace hysteron
 
     template <int dim>
     void
-    Solver<dim>::record_dashpots(const unsigned int first, const unsigned int d, const double v_mid, const double dt)
+    Solver<dim>::record_dashpots(const unsigned int first,
+                                 const unsigned int d,
+                                 const double       v_mid,
+                                 const double       dt)
     {
       const unsigned int n = dashpots[first - 1].node;
       for (std::size_t k = first - 1; k < dashpots.size() && dashpots[k].node == n; ++k)

@@ -51,7 +51,11 @@ namespace hysteron
        * stable), with the dashpot c of absorbing boundaries given as @p extra = c / m.
        */
       double
-      velocity_change(const double inv_m, const double v, const double f, const double dt, const double extra = 0) const
+      velocity_change(const double inv_m,
+                      const double v,
+                      const double f,
+                      const double dt,
+                      const double extra = 0) const
       {
         const double f_local = f - local * std::abs(f) * ((v > 0) - (v < 0));
         const double rate    = mass + extra;
