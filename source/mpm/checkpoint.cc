@@ -25,7 +25,7 @@ namespace hysteron
     namespace
     {
       /// The format of what this file stores: raise it with every change of a description below.
-      constexpr std::uint32_t format = 2;
+      constexpr std::uint32_t format = 3;
 
       /**
        * One material point in a checkpoint. Its fields are listed once, in fields():
@@ -138,6 +138,12 @@ namespace hysteron
           // Only a damped run has this section (undamped checkpoints keep their format).
           ar.section("mpm damping", format);
           ar &damping_work;
+        }
+      if (!probe_acceleration.empty())
+        {
+          // With a ground motion: the probes' accelerations of the last step (partial sums).
+          ar.section("mpm ground motion", format);
+          ar &probe_acceleration;
         }
     }
 
@@ -359,7 +365,8 @@ namespace hysteron
         {
           Run::sum_rank_parts(rank_parts, this->get_scene().is_root(),
                               [this](CheckpointReader &part) { serialize_rank(part); },
-                              internal_work, external_work, boundary_work, reactions, damping_work);
+                              internal_work, external_work, boundary_work, reactions, damping_work,
+                              probe_acceleration);
           n_changed_cells = 0;
         }
       restore_points(directory.same_ranks());

@@ -18,15 +18,11 @@ namespace hysteron
     void
     Solver<dim>::setup_boundaries()
     {
-      using Type              = typename BoundaryDescription<dim>::Type;
       const Scene<dim> &scene = this->get_scene();
       const auto       &lattice = grid->lattice();
       boundaries.clear();
       for (const auto &description : scene.boundary_descriptions())
         {
-          require(description.type != Type::absorbing,
-                  "Boundary " + description.name + "/Type",
-                  "absorbing boundaries are FEM-only for now (Method = fem, a dynamic analysis)");
           BoundaryNodes b;
           b.name       = description.name;
           b.type       = static_cast<unsigned int>(description.type);
@@ -197,7 +193,7 @@ namespace hysteron
                     // Lower face (sign +1): the body may not move in -d; upper face: not in +d.
                     impose(r, d, bc.normal_sign[k] > 0 ? std::max(r[1 + d], 0.0) : std::min(r[1 + d], 0.0), n, reactions[b]);
                     break;
-                  case Type::absorbing: // refused by setup_boundaries()
+                  case Type::absorbing: // dashpots in the velocity update (absorbing.cc)
                     break;
                 }
             }

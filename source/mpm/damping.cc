@@ -78,6 +78,8 @@ namespace hysteron
           for (unsigned int c = 0; c < dim; ++c)
             {
               const Type type = static_cast<Type>(b.type);
+              if (type == Type::absorbing) // sets no component
+                continue;
               if (type == Type::fixed || (type != Type::velocity && type != Type::displacement ?
                                             c == b.normal_direction[k] :
                                             bool(b.components[c])))
@@ -114,7 +116,8 @@ namespace hysteron
     {
       // As update_nodal_velocities(), with NodalDamping::velocity_change(); the damping
       // work of the owned nodes (each shared node once), of the components no boundary
-      // condition or rigid body sets (there the reaction takes the damping force).
+      // condition or rigid body sets (there the reaction takes the damping force), and the
+      // same for the dashpots' reactions and work (absorbing.cc).
       constexpr unsigned int C    = 1 + 2 * dim;
       double *const          node = grid->data().data();
       const double           tiny = small_mass;
@@ -130,13 +133,22 @@ namespace hysteron
             }
           const double inv_m = 1.0 / r[0];
           const unsigned int held = grid->is_owned(n) && rigid_node_body[n] == 0 ? boundary_node[n] : ~0u;
+          // Absorbing boundaries: the node's dashpots c (summed over its faces), as c / m.
+          const unsigned int     first = dashpots.empty() ? 0 : dashpot_first[n];
+          dealii::Tensor<1, dim> c;
+          for (std::size_t k = first; k > 0 && k <= dashpots.size() && dashpots[k - 1].node == n; ++k)
+            c += dashpots[k - 1].c;
           for (unsigned int d = 0; d < dim; ++d)
             {
               const double v  = nodes_hold_momenta ? r[1 + d] * inv_m : r[1 + d];
               const double f  = r[1 + dim + d];
-              const double dv = nodal_damping.velocity_change(inv_m, v, f, dt);
+              const double dv = nodal_damping.velocity_change(inv_m, v, f, dt, c[d] * inv_m);
               if (!(held & (1u << d)))
-                work += nodal_damping.work(r[0], v, f, dv, dt);
+                {
+                  work += nodal_damping.work(r[0], v, f, dv, dt);
+                  if (first > 0)
+                    record_dashpots(first, d, v + 0.5 * dv, dt);
+                }
               r[1 + dim + d] = dv;
               r[1 + d]       = v + dv;
             }

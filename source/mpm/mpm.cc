@@ -313,6 +313,11 @@ namespace hysteron
       axisymmetric = scene.axisymmetric();
       if (axisymmetric)
         {
+          // A uniform ground motion across the axis (x = r) has no axisymmetric part.
+          require(scene.ground_motion().empty() || scene.ground_motion().direction()[0] == 0,
+                  "Ground motion/Direction",
+                  "has a radial (x) component in an axisymmetric scene: the ground of an "
+                  "axisymmetric body can move along its axis only (Direction = 0, 1)");
           // x is the radius: the grid may not reach r < 0, and a grid that reaches the
           // axis needs v_r = 0 there (else the hoop strain v_r / r is unbounded).
           require(lower[0] >= 0,
@@ -434,6 +439,7 @@ namespace hysteron
           probes.push_back(probe);
         }
       load_per_point.assign(scene.load_descriptions().size() + 1, dealii::Tensor<1, dim>());
+      probe_acceleration.assign(scene.ground_motion().empty() ? 0 : probes.size(), dealii::Tensor<1, dim>());
       reactions.assign(scene.boundary_descriptions().size() + scene.body_descriptions().size(),
                        dealii::Tensor<1, dim>());
       // The grid and the points: new, or from the checkpoint of --resume (the points go
@@ -450,6 +456,7 @@ namespace hysteron
         }
       setup_boundaries();
       setup_grid_motion();
+      setup_absorbing();
       // The smallest mass a node may have and still get a velocity.
       double m_min = std::numeric_limits<double>::max();
       for (const double m : particles.mass)
@@ -457,7 +464,7 @@ namespace hysteron
       m_min      = dealii::Utilities::MPI::min(m_min, scene.mpi_communicator());
       small_mass = 1e-12 * m_min;
       // The basis and contact are chosen once: the phase kernels are templates of them.
-      if (nodal_damping.active() && !contact)
+      if ((nodal_damping.active() || !dashpots.empty()) && !contact)
         mark_boundary_nodes();
       if (contact)
         {
@@ -579,6 +586,8 @@ namespace hysteron
         fail_at_t(describe_failure(t));
       if (const std::string diverged = check_energy(t, dt, step_critical); !diverged.empty())
         fail_at_t(diverged);
+      if (!probe_acceleration.empty())
+        record_probe_accelerations(dt);
       particles.commit();
       t += dt;
       if (grid_moves)

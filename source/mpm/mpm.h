@@ -46,14 +46,20 @@ namespace hysteron
 
       /**
        * The velocity change over @p dt of one component of a node with 1 / m = @p inv_m,
-       * velocity @p v and force @p f, from m (v' - v) / dt = f - alpha |f| sgn(v) - a0 m
-       * (v + v') / 2 (the mass term trapezoidal: exact decay to O((a0 dt)^3), any a0 dt stable).
+       * velocity @p v and force @p f, from m (v' - v) / dt = f - alpha |f| sgn(v) - (a0 m + c)
+       * (v + v') / 2 (the viscous terms trapezoidal: exact decay to O((a0 dt)^3), any a0 dt
+       * stable), with the dashpot c of absorbing boundaries given as @p extra = c / m.
        */
       double
-      velocity_change(const double inv_m, const double v, const double f, const double dt) const
+      velocity_change(const double inv_m,
+                      const double v,
+                      const double f,
+                      const double dt,
+                      const double extra = 0) const
       {
         const double f_local = f - local * std::abs(f) * ((v > 0) - (v < 0));
-        return dt * (f_local * inv_m - mass * v) / (1.0 + 0.5 * mass * dt);
+        const double rate    = mass + extra;
+        return dt * (f_local * inv_m - rate * v) / (1.0 + 0.5 * rate * dt);
       }
 
       /// The work the damping forces of velocity_change() take out over @p dt (mass @p m,
@@ -123,6 +129,13 @@ namespace hysteron
 
       bool
       takes_continuum_materials() const override
+      {
+        return true;
+      }
+
+      /// Base excitation (doc/mpm.md "Base excitation"): the body force -a_g(t) d.
+      bool
+      takes_ground_motion() const override
       {
         return true;
       }
@@ -346,9 +359,34 @@ namespace hysteron
       nodal_velocities();
       void
       update_nodal_velocities(const double dt);
-      /// update_nodal_velocities() with the nodal damping, and its work (damping.cc).
+      /// update_nodal_velocities() with the nodal damping and the dashpots of absorbing
+      /// boundaries, and their work (damping.cc).
       void
       update_damped_nodal_velocities(const double dt);
+
+      // Absorbing boundaries (`Boundary/Type = absorbing`, absorbing.cc; doc/mpm.md
+      // "Absorbing boundaries"): Lysmer-Kuhlemeyer dashpots on the grid nodes of faces.
+      struct Dashpot
+      {
+        unsigned int           node     = 0; ///< local grid node
+        unsigned int           boundary = 0; ///< index of the condition (its reaction)
+        dealii::Tensor<1, dim> c;            ///< per component: rho c_p A (normal), rho c_s A [kg/s]
+      };
+      /// Sorted by node; a node on several absorbing faces has one per face.
+      std::vector<Dashpot>    dashpots;
+      /// Per local node: 1 + the index of its first dashpot, 0: none.
+      ZeroPages<unsigned int> dashpot_first;
+      /// After setup_boundaries(): the dashpots of every absorbing condition.
+      void
+      setup_absorbing();
+      /// The deformable body whose material lies behind the absorbing condition @p b
+      /// (points in the grid cells next to its faces); refused if none or several materials.
+      unsigned int
+      absorbing_body(const unsigned int b) const;
+      /// The forces of the dashpots from @p first (of node n) on component @p d at the
+      /// mid-step velocity @p v_mid: their reactions and work (boundary_work).
+      void
+      record_dashpots(const unsigned int first, const unsigned int d, const double v_mid, const double dt);
 
       // Damping (`MPM/Damping`, damping.cc; doc/mpm.md, "Damping").
       NodalDamping nodal_damping;
@@ -453,6 +491,14 @@ namespace hysteron
       std::vector<bool> boundary_acted; ///< per boundary: has it constrained a node with mass
       std::vector<Probe>                                 probes;
       std::vector<dealii::Tensor<1, dim>>                load_per_point; ///< per load, at t
+      /// The body force per unit mass at the step's start t, g - a_g(t) d (begin_step()).
+      dealii::Tensor<1, dim>                             body_acceleration;
+      /// With a ground motion: per probe, the relative acceleration (v_p' - v_p) / dt of
+      /// its point in the last step on the rank that took the step for it, zero on the
+      /// others (partial sums, as the tables take them); empty without a ground motion.
+      std::vector<dealii::Tensor<1, dim>>                probe_acceleration;
+      void
+      record_probe_accelerations(const double dt);
       std::vector<double>                                load_scale;     ///< 1 / count or area
       std::vector<std::vector<double>>                   particle_load_area;
 

@@ -39,6 +39,12 @@ namespace hysteron
 
       for (unsigned int l = 1; l < load_per_point.size(); ++l)
         load_per_point[l] = this->get_scene().load_descriptions()[l - 1].value_at(t);
+      // Gravity and the ground's acceleration, g - a_g(t) d (the motion is relative to the
+      // ground), at the step's start like the loads: the forces of USL and MUSL are those of
+      // the state at t (symplectic Euler), and external_work takes the same force, so the
+      // energy balance stays closed. Against a_g(t + dt / 2) this shifts the record by dt / 2,
+      // far below its sampling step.
+      body_acceleration = this->get_scene().body_acceleration(t);
     }
 
 
@@ -69,7 +75,7 @@ namespace hysteron
       constexpr unsigned int C    = 1 + 2 * dim;
       double *const          node = grid->data().data();
       const double           tiny = small_mass;
-      if (nodal_damping.active())
+      if (nodal_damping.active() || !dashpots.empty())
         update_damped_nodal_velocities(dt);
       else if (nodes_hold_momenta)
         // Delta v_i = dt f_i / m_i, v_i' = p_i / m_i + Delta v_i; nodes without

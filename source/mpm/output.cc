@@ -148,6 +148,14 @@ namespace hysteron
       for (unsigned int b = 0; b < bodies.size(); ++b)
         if (bodies[b].rigid)
           r.push_back(reactions[boundaries.size() + b]);
+      if (!probe_acceleration.empty())
+        {
+          std::vector<double> a;
+          for (const auto &acceleration : probe_acceleration)
+            for (unsigned int d = 0; d < dim; ++d)
+              a.push_back(acceleration[d]);
+          tables.set_probe_accelerations(std::move(a));
+        }
       tables.write(t,
                    rows,
                    averages,
@@ -156,6 +164,23 @@ namespace hysteron
                    comm,
                    {},
                    damping_work);
+    }
+
+
+
+    template <int dim>
+    void
+    Solver<dim>::record_probe_accelerations(const double dt)
+    {
+      // The relative acceleration of each probe's point over the step just taken (before
+      // commit()): (v_p' - v_p) / dt, with FLIP sum_i N_ip Delta v_i / dt, the nodes'
+      // accelerations after the boundary conditions. A rank that no longer has the point
+      // (it migrated after its step) keeps its value until the new owner's next step.
+      const auto &P = particles;
+      for (unsigned int i = 0; i < probes.size(); ++i)
+        probe_acceleration[i] = probes[i].local >= 0 ?
+                                  (P.next.v[probes[i].local] - P.current.v[probes[i].local]) / dt :
+                                  dealii::Tensor<1, dim>();
     }
 
 
@@ -187,6 +212,8 @@ namespace hysteron
     template void Solver<3>::write_particle_table() const;
     template void Solver<2>::write_table_rows(double);
     template void Solver<3>::write_table_rows(double);
+    template void Solver<2>::record_probe_accelerations(double);
+    template void Solver<3>::record_probe_accelerations(double);
     template void Solver<2>::write_fields(double, Output::FieldWriter &);
     template void Solver<3>::write_fields(double, Output::FieldWriter &);
   } // namespace MPM

@@ -28,7 +28,6 @@ namespace hysteron
       constexpr unsigned int K       = contact_block;
       double *const          node    = grid->data().data();
       const auto            &cur     = particles.current;
-      const Tensor<1, dim>   gravity = this->get_scene().gravity();
       // Contact: body b's block of node n is layer[n * L + b * K, ...).
       double *const     layer = with_contact ? grid->layer_data().data() : nullptr;
       const std::size_t L     = with_contact ? std::size_t(K) * n_contact_blocks : 0;
@@ -85,10 +84,10 @@ namespace hysteron
               const double ms = with_contact ? m / particles.thickness[p] : 0.0;
               if constexpr (with_forces)
                 {
-                  // f_i += N_ip (m_p g + f_p) - V_p sigma_p grad N_ip (axisymmetric: and
-                  // - N_ip V_p sigma_tt / r_p e_r, the hoop term, joins m_p g + f_p)
+                  // f_i += N_ip (m_p b + f_p) - V_p sigma_p grad N_ip with b = g - a_g(t) d
+                  // (axisymmetric: and - N_ip V_p sigma_tt / r_p e_r, the hoop term, joins m_p b + f_p)
                   Tensor<1, dim> f_ext =
-                    m * gravity + particles.load_factor[p] * load_per_point[particles.load[p]];
+                    m * body_acceleration + particles.load_factor[p] * load_per_point[particles.load[p]];
                   if (dim == 2 && axisymmetric)
                     f_ext[0] -= hoop_force(group, p, cur);
                   const SymmetricTensor<2, dim> vs = cur.volume[p] * cur.stress[p];
@@ -163,7 +162,6 @@ namespace hysteron
       const std::size_t      L       = with_contact ? std::size_t(K) * n_contact_blocks : 0;
       const auto            &cur     = particles.current;
       const auto            &state   = updated_stresses ? particles.next : particles.current;
-      const Tensor<1, dim>   gravity = this->get_scene().gravity();
 
       // Viscous: the strain rates come from the nodal velocities (not momenta).
       Assert(!viscous || !nodes_hold_momenta, dealii::ExcInternalError());
@@ -180,7 +178,7 @@ namespace hysteron
               {
                 support.reinit(g.lattice, *grid, cur.x[p], g.inv_h);
                 Tensor<1, dim> f_ext =
-                  particles.mass[p] * gravity +
+                  particles.mass[p] * body_acceleration +
                   particles.load_factor[p] * load_per_point[particles.load[p]];
                 if (dim == 2 && axisymmetric)
                   f_ext[0] -= hoop_force(group, p, state);
@@ -232,7 +230,6 @@ namespace hysteron
       const std::size_t      stride  = with_contact ? std::size_t(K) * n_contact_blocks : C;
       const auto            &cur     = particles.current;
       auto                  &nxt     = particles.next;
-      const Tensor<1, dim>   gravity = this->get_scene().gravity();
 
       // Velocities (FLIP/PIC blend) and positions.
       const double alpha = flip_fraction;
@@ -275,7 +272,7 @@ namespace hysteron
               group_max_speed            = std::max(group_max_speed, v_new.norm_square());
               group_kinetic += particles.mass[p] * v_new.norm_square();
               const Tensor<1, dim> f_ext =
-                particles.mass[p] * gravity +
+                particles.mass[p] * body_acceleration +
                 particles.load_factor[p] * load_per_point[particles.load[p]];
               external_work += 0.5 * dt * (f_ext * (cur.v[p] + v_new));
               track_cell(p, nxt.x[p]);
