@@ -100,13 +100,13 @@ namespace hysteron
                         "separate but not penetrate (normal velocity into the wall set to zero); "
                         "velocity: the `Components` follow `Velocity`(t); displacement: the "
                         "`Components` follow `Displacement`(t) (displacement control; the MPM "
-                        "imposes the mean velocity of each step); absorbing (fem, dynamic "
-                        "analyses only): viscous Lysmer-Kuhlemeyer dashpots that let waves "
-                        "leave, the traction t = -rho c_p (v.n) n - rho c_s (v - (v.n) n) with "
-                        "c_p, c_s the wave speeds of the elastic constants of the body the face "
-                        "belongs to (exact at normal incidence, see doc/fem.md); it needs "
-                        "`Faces` or a `Set` of boundary faces (a Gmsh group of faces) for the "
-                        "normal n, not a region.");
+                        "imposes the mean velocity of each step); absorbing (fem dynamic analyses "
+                        "and mpm): viscous Lysmer-Kuhlemeyer dashpots that let waves leave, the "
+                        "traction t = -rho c_p (v.n) n - rho c_s (v - (v.n) n) with c_p, c_s the "
+                        "wave speeds of the elastic constants of the body next to the face "
+                        "(exact at normal incidence, see doc/fem.md and doc/mpm.md); it needs "
+                        "`Faces` or a `Set` of boundary faces (a Gmsh group of faces, fem) for "
+                        "the normal n, not a region.");
       prm.declare_entry("Faces",
                         "",
                         Patterns::Anything(),

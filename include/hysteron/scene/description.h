@@ -125,7 +125,7 @@ namespace hysteron
       wall,         ///< rigid frictionless wall: the normal component may not point into the wall
       velocity,     ///< the selected components of the velocity follow functions of t
       displacement, ///< the selected components of the displacement follow functions of t
-      absorbing     ///< viscous (Lysmer-Kuhlemeyer) dashpots on boundary faces (FEM dynamics only)
+      absorbing     ///< viscous (Lysmer-Kuhlemeyer) dashpots on boundary faces (FEM dynamics, MPM)
     };
     std::string                                name;
     Type                                       type = Type::fixed;
