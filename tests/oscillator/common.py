@@ -42,3 +42,29 @@ class Checks:
         if self.failures:
             sys.exit(f"{len(self.failures)} check(s) failed")
         print("all checks passed")
+
+
+def uniaxial_bench(hysteron, workdir, name, E, SY, law, path, end, steps):
+    """Run the uniaxial bench (Method = uniaxial) with Young's modulus @p E, the Bouc-Wen
+    yield stress @p SY and the entries @p law of subsection Bouc-Wen, along the strain
+    expression @p path in @p steps steps to @p end; returns history.csv's columns."""
+    text = f"""set Dimension = 2
+set Method    = uniaxial
+subsection Material
+  set Young's modulus = {E!r}
+  subsection Bouc-Wen
+    set Yield stress = {SY!r}
+{law}
+  end
+end
+subsection Uniaxial
+  set Strain   = {path}
+  set End time = {end}
+  set Steps    = {steps}
+end
+subsection Output
+  set Directory = {name}
+end
+"""
+    run(hysteron, workdir, name, text)
+    return table(os.path.join(workdir, name, "history.csv"))

@@ -17,7 +17,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "oscillator"))
-from common import Checks, run, table  # noqa: E402
+from common import Checks, uniaxial_bench  # noqa: E402
 
 E, SY = 200e9, 200e6
 EY = SY / E  # yield strain 1e-3
@@ -133,30 +133,8 @@ def rk4_history(law, steps, substeps):
     return out
 
 
-def scene(law_entries, steps, path=PATH, end=END):
-    return f"""set Dimension = 2
-set Method    = uniaxial
-subsection Material
-  set Young's modulus = {E}
-  subsection Bouc-Wen
-    set Yield stress = {SY}
-{law_entries}
-  end
-end
-subsection Uniaxial
-  set Strain   = {path}
-  set End time = {end}
-  set Steps    = {steps}
-end
-subsection Output
-  set Directory = {{name}}
-end
-"""
-
-
-def bench(hysteron, workdir, name, entries, steps, **kw):
-    run(hysteron, workdir, name, scene(entries, steps, **kw).replace("{name}", name))
-    return table(os.path.join(workdir, name, "history.csv"))
+def bench(hysteron, workdir, name, entries, steps, path=PATH, end=END):
+    return uniaxial_bench(hysteron, workdir, name, E, SY, entries, path, end, steps)
 
 
 LAWS = {

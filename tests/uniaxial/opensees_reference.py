@@ -25,7 +25,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "oscillator"))
-from common import Checks, run, table  # noqa: E402
+from common import Checks, uniaxial_bench  # noqa: E402
 
 HERE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "opensees_reference")
 TOLERANCE = 1e-6
@@ -85,35 +85,13 @@ def bwbn(p):
 LAWS = {"BoucWen": (bouc_wen, (6, 7, 8)), "BoucWenOriginal": (bouc_wen_original, ()), "BWBN": (bwbn, (7,))}
 
 
-def scene(E, SY, law, path, end, steps):
-    return f"""set Dimension = 2
-set Method    = uniaxial
-subsection Material
-  set Young's modulus = {E!r}
-  subsection Bouc-Wen
-    set Yield stress = {SY!r}
-{law}
-  end
-end
-subsection Uniaxial
-  set Strain   = {path}
-  set End time = {end}
-  set Steps    = {steps}
-end
-subsection Output
-  set Directory = {{name}}
-end
-"""
-
-
 def bench(hysteron, workdir, name, args, numbers):
     """sigma and eps of the bench along the driver's path with the mapped @p numbers."""
     material, amplitude, drift, end, steps = args[:5]
     E, SY, law = LAWS[material][0](numbers)
     # The driver's strain: amplitude t / end sin(2 pi t) + drift t / end, in this order.
     strain = f"{amplitude}*t/{end}*sin(2*pi*t) + {drift}*t/{end}"
-    run(hysteron, workdir, name, scene(E, SY, law, strain, end, steps).replace("{name}", name))
-    return table(os.path.join(workdir, name, "history.csv"))
+    return uniaxial_bench(hysteron, workdir, name, E, SY, law, strain, end, steps)
 
 
 def difference(h, ref, rows, column, index):
